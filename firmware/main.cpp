@@ -1,0 +1,7 @@
+// Placeholder firmware entry point (replaced by the firmware issue).
+#include <avr/io.h>
+
+int main() {
+    for (;;) {
+    }
+}

@@ -1,0 +1,55 @@
+// What the G-code layer asks of the motion side (planner + step generator). The protocol and
+// the G-code executor use only this header; tests can replace it with a recording fake.
+#pragma once
+
+#include "lowlevel/config.h"
+
+namespace ll {
+namespace motion {
+
+/// One straight move in machine coordinates.
+struct LineRequest {
+    int32_t target_steps[kAxes]; ///< absolute target, steps: round_half_away(mm * steps/mm)
+    int32_t target_um[kAxes];    ///< absolute target, mm x1000 (deg x1000 on a rotary axis)
+    uint32_t feed;               ///< F in units/min x1000; ignored when `rapid`
+    bool rapid;                  ///< G0: as fast as every axis allows
+};
+
+/// True when the planner has room for one more move.
+bool can_accept();
+/// Queues a move. Precondition: can_accept(). A move of zero length is dropped silently (as
+/// GRBL does) but still counts as accepted.
+void push_line(const LineRequest& req);
+/// Free planner blocks (first field of `Bf:`).
+uint8_t blocks_free();
+
+/// Background work: plans, produces runs, starts the step timer, handles the idle delay ($1).
+/// Call it from every wait loop; it never blocks.
+void poll();
+
+enum class State : uint8_t {
+    Idle,     ///< nothing queued, nothing moving
+    Cycle,    ///< moving or about to move
+    Holding,  ///< feed hold requested, decelerating (GRBL "Hold:1")
+    Held,     ///< feed hold complete, motion stopped and resumable (GRBL "Hold:0")
+};
+State state();
+
+/// Feed hold: decelerate along the path to a stop, losing no step.
+void feed_hold();
+/// Resumes after a feed hold (no effect otherwise).
+void cycle_start();
+/// Stops at once and forgets everything queued (soft reset). Returns true when steps were
+/// being emitted, i.e. the position may be lost (GRBL raises ALARM:3 then).
+bool abort();
+
+/// Current machine position, steps, as executed by the step interrupt so far.
+void position(int32_t steps[kAxes]);
+/// Current feed along the regulated path, units/min (for `FS:`).
+uint32_t current_feed();
+
+/// The settings changed: recompute derived tables. Only called while state() == Idle.
+void settings_changed();
+
+} // namespace motion
+} // namespace ll

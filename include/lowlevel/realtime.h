@@ -1,0 +1,40 @@
+// GRBL 1.1 real-time commands, picked out of the byte stream by the receive interrupt.
+#pragma once
+
+#include <stdint.h>
+
+namespace ll {
+namespace rt {
+
+/// Pending real-time requests, as bits. Set by the receive interrupt, taken by the main loop.
+enum : uint8_t {
+    kStatusReport = 1 << 0, ///< '?'
+    kFeedHold = 1 << 1,     ///< '!'
+    kCycleStart = 1 << 2,   ///< '~'
+    kReset = 1 << 3,        ///< 0x18 (ctrl-X)
+};
+
+extern volatile uint8_t g_pending;
+
+/// Called by the receive interrupt for every byte. Returns true when the byte is a real-time
+/// command (it is then consumed here and never enters the receive buffer). Besides the four
+/// commands above, GRBL 1.1's extended real-time bytes (0x84 safety door, 0x85 jog cancel,
+/// 0x87 debug, 0x90-0x9D overrides, 0xA0-0xA1 accessories) are consumed and ignored: a sender
+/// may send them at any time and they must not corrupt a line.
+inline bool filter(uint8_t byte) {
+    switch (byte) {
+        case '?': g_pending |= kStatusReport; return true;
+        case '!': g_pending |= kFeedHold; return true;
+        case '~': g_pending |= kCycleStart; return true;
+        case 0x18: g_pending |= kReset; return true;
+        default: break;
+    }
+    if (byte < 0x84) return false;
+    return byte <= 0x87 || (byte >= 0x90 && byte <= 0x9D) || byte == 0xA0 || byte == 0xA1;
+}
+
+/// Takes and clears the pending bits (interrupts off for the read-modify-write).
+uint8_t take();
+
+} // namespace rt
+} // namespace ll

@@ -1,0 +1,25 @@
+// Storage shared between the main loop and the step / receive interrupts.
+#include "lowlevel/hal.h"
+#include "lowlevel/realtime.h"
+#include "lowlevel/run_queue.h"
+#include "lowlevel/settings.h"
+
+namespace ll {
+
+RunQueue g_runs;
+StepExec g_exec;
+Settings g_settings;
+
+namespace rt {
+
+volatile uint8_t g_pending;
+
+uint8_t take() {
+    hal::Critical cs;
+    uint8_t p = g_pending;
+    g_pending = 0;
+    return p;
+}
+
+} // namespace rt
+} // namespace ll

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs the Debian packages Low Level needs, only those that are missing.
+# Usage: tools/deps.sh [test|demo]   (sourced or run; needs root or sudo when something is missing)
+set -euo pipefail
+pkgs=(cmake make g++ gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev
+      libgtest-dev pkg-config)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "== installing: ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO=sudo
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
