@@ -113,7 +113,9 @@ void deliver_arrivals(uint64_t t) {
 
 } // namespace
 
-uint64_t now() { return m().now; }
+uint64_t now() {
+    return m().now;
+}
 
 void advance_to(uint64_t t) {
     Model& s = m();
@@ -130,10 +132,18 @@ void advance_to(uint64_t t) {
 uint64_t next_event() {
     return m().running ? m().next_event : std::numeric_limits<uint64_t>::max();
 }
-bool timer_running() { return m().running; }
-const std::vector<Edge>& edges() { return m().edges; }
-void clear_edges() { m().edges.clear(); }
-uint32_t timer_stops() { return m().stops; }
+bool timer_running() {
+    return m().running;
+}
+const std::vector<Edge>& edges() {
+    return m().edges;
+}
+void clear_edges() {
+    m().edges.clear();
+}
+uint32_t timer_stops() {
+    return m().stops;
+}
 
 void send(const std::string& bytes, uint32_t cycles_per_byte) {
     Model& s = m();
@@ -174,7 +184,9 @@ void reset_model(bool erase_eeprom) {
     rt::g_pending = 0;
 }
 
-uint8_t* eeprom() { return m().eeprom; }
+uint8_t* eeprom() {
+    return m().eeprom;
+}
 
 } // namespace host
 
@@ -200,8 +212,12 @@ bool serial_rx_overflowed() {
     return o;
 }
 
-void serial_rx_clear() { host::m().rx.clear(); }
-void serial_put(uint8_t byte) { host::m().tx.push_back(static_cast<char>(byte)); }
+void serial_rx_clear() {
+    host::m().rx.clear();
+}
+void serial_put(uint8_t byte) {
+    host::m().tx.push_back(static_cast<char>(byte));
+}
 void serial_flush() {}
 
 void stepper_configure(const StepperConfig& cfg) {
@@ -236,14 +252,24 @@ void stepper_enable(bool on) {
     }
 }
 
-uint32_t millis() { return static_cast<uint32_t>(host::m().now / (kCpuHz / 1000)); }
+uint32_t millis() {
+    return static_cast<uint32_t>(host::m().now / (kCpuHz / 1000));
+}
 
-uint8_t eeprom_read(uint16_t addr) { return host::m().eeprom[addr % kEepromSize]; }
-void eeprom_write(uint16_t addr, uint8_t value) { host::m().eeprom[addr % kEepromSize] = value; }
+uint8_t eeprom_read(uint16_t addr) {
+    return host::m().eeprom[addr % kEepromSize];
+}
+void eeprom_write(uint16_t addr, uint8_t value) {
+    host::m().eeprom[addr % kEepromSize] = value;
+}
 
-uint8_t limits() { return 0; }
+uint8_t limits() {
+    return 0;
+}
 
-uint8_t irq_save() { return 0; }
+uint8_t irq_save() {
+    return 0;
+}
 void irq_restore(uint8_t) {}
 
 } // namespace hal

@@ -1,0 +1,49 @@
+// Straight lines in tick space (seed part III, §7).
+//
+// §7.1: axes that do not move are dropped and the others sorted by distance, decreasing; the
+// longest one ("axis 1", sorted position 0 here) is the reference variable x_1.
+// §7.2: positions are x_j = (S_j * x_1 + P/2) >> k with P = 2^k and S_j = round(s_j * P): one
+// integer multiplication (done incrementally, as an addition per macro segment) and a shift.
+// The +P/2 rounds to the nearest tick instead of the seed's floor, which halves the deviation;
+// with P >= 8 d_1 every macro position is within 0.5 + 1/16 tick of the ideal line and the end
+// point is reached exactly (docs/motion.md, "Line positions").
+#pragma once
+
+#include "lowlevel/config.h"
+
+namespace ll {
+
+/// Longest reference-axis distance of one line, ticks. Keeps S_j * L + P within 32 bits
+/// (k <= 27 with P >= 8 d_1). Longer moves are split by the planner.
+constexpr uint32_t kMaxLineTicks = 1ul << 24;
+/// Longest macro segment (reference-axis ticks between two computed positions).
+constexpr uint8_t kMaxSegmentTicks = 16;
+
+struct LineGeometry {
+    uint8_t m;             ///< moving axes
+    uint8_t shift;         ///< k, with 2^k >= 8 * dist[0]
+    uint8_t dirs;          ///< machine-axis bits travelling towards negative coordinates
+    uint8_t axis[kAxes];   ///< machine axis at each sorted position (0 = reference axis)
+    uint32_t dist[kAxes];  ///< ticks to travel at each sorted position, decreasing
+    uint32_t slope[kAxes]; ///< S_j = round(dist[j] * 2^k / dist[0]); slope[0] = 2^k
+};
+
+/// Sets up the line from the per-axis deltas (ticks). Returns false for a zero-length line or
+/// one longer than kMaxLineTicks on its reference axis.
+bool line_setup(LineGeometry& g, const int32_t delta[kAxes]);
+
+/// Macro position along a line (seed §2.1), in ticks travelled per sorted position.
+struct LineCursor {
+    uint32_t x1;          ///< reference-axis ticks travelled
+    uint32_t pos[kAxes];  ///< ticks travelled at each sorted position
+    uint32_t frac[kAxes]; ///< fractional part of S_j * x_1 + P/2, k bits
+};
+
+void line_start(const LineGeometry& g, LineCursor& c);
+
+/// Moves the macro position `len` reference ticks further (1 <= len <= kMaxSegmentTicks and
+/// len <= dist[0] - x1) and writes the increment of each sorted position into e[0..m).
+/// e[0] == len and e[j] <= len.
+void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[kAxes]);
+
+} // namespace ll

@@ -1,0 +1,62 @@
+// Speed as a function of travelled distance (seed §4, §8), square-root free.
+//
+// Along a move, distance is counted in ticks of its reference axis (x, seed §8.1). With
+// constant acceleration the squared speed is affine in x (§4.4: V^2 = V_d^2 +- 2 a l), so the
+// profile works on A(x) = s * (l_d + x), the seed's "fictive distance from rest" l_d + x scaled
+// by s = 2 * 4^m. Then V is proportional to sqrt(A) and the wait time of the reference axis is
+// Delta_1 = D / sqrt(A) (§4.5, §8.1). sqrt(A) is never computed: an integer R with R^2 <= A
+// follows A as it moves (§8.2: "quand x_1 dépasse C, R += 1, C = R.R"), and Delta_1 = D / R is
+// one division, done only when R changes. The scale s refines the seed's scheme (which
+// changes speed only at perfect squares of x): with s = 2 * 4^m, R changes 2^m * sqrt(2) times
+// as often. Each macro segment is timed at its midpoint (A evaluated at x + L/2), which is what
+// makes the first steps right. docs/motion.md quantifies both schemes.
+//
+// The profile has the seed's shape (§4.1): the speed changes (up or down) at the start of the
+// move, then cruises, and only decelerates at the end; the deceleration point and, when the
+// cruise speed cannot be reached, the peak come from the closed form
+//   A_peak = (A_entry + A_exit + s d) / 2      (v_p^2 = (v_0^2 + v_1^2) / 2 + a L)
+//   x_decel = (A_exit - A_entry + s d) / (2 s)
+#pragma once
+
+#include <stdint.h>
+
+namespace ll {
+
+struct Profile {
+    uint32_t d;        ///< reference-axis ticks of the profile
+    uint32_t s;        ///< scale: A grows by s per tick of acceleration
+    uint32_t a_entry;  ///< A at x = 0
+    uint32_t a_cruise; ///< A at the nominal (cruise) speed
+    uint32_t a_exit;   ///< A at x = d
+    uint32_t d_num;    ///< numerator: Delta_1 = d_num / sqrt(A), CPU cycles x 256
+    uint32_t cruise;   ///< Delta_1 at cruise, CPU cycles x 256 (exact: one division per move)
+};
+
+/// The closed-form shape of a profile (seed §4.1, docs/motion.md "Peak and deceleration point").
+struct ProfileShape {
+    bool reaches_cruise;
+    uint32_t a_peak;   ///< highest (or, decelerating at the start, lowest) A of the move
+    uint32_t x_change; ///< reference ticks x 2 where the start change ends
+    uint32_t x_decel;  ///< reference ticks x 2 where the end deceleration starts
+};
+ProfileShape profile_shape(const Profile& p);
+
+/// A at half-tick position x2 = 2 x (so that segment midpoints are exact):
+///   A(x) = min(start(x), A_exit + s (d - x)), start(x) = A_entry +- s x clamped at A_cruise.
+/// The profile must be feasible: A_entry <= A_exit + s d (the planner guarantees it).
+uint32_t profile_a(const Profile& p, uint32_t x2);
+
+/// The integer square root that follows A (seed §8.2), with C = R^2 and the next square kept
+/// so that a step of R costs an addition.
+struct SqrtTracker {
+    uint32_t r;      ///< floor(sqrt(A))
+    uint32_t c;      ///< r^2
+    uint32_t c_next; ///< (r + 1)^2
+    uint16_t steps;  ///< R changes since reset (for the docs' cost figures)
+
+    void reset(uint32_t a);
+    /// Moves R to floor(sqrt(a)). Returns true when R changed.
+    bool seek(uint32_t a);
+};
+
+} // namespace ll

@@ -1,0 +1,139 @@
+// The step generator: the producer side of the compute windows (seed §6). It turns one
+// straight move into runs (axis set, count, period) for the step interrupt, a macro segment at
+// a time, from the main loop, while the interrupt executes the runs queued before.
+//
+// Per macro segment (docs/motion.md, "Compute windows"):
+//   1. the segment length L (reference-axis ticks, a power of two <= 16) is the smallest that
+//      makes the segment last at least kSegmentCycles at the current speed, so that producing
+//      the next segment always takes less time than executing this one;
+//   2. the speed at the segment's midpoint comes from the sqrt-free profile (profile.h);
+//   3. the next macro position comes from the line (line.h), the runs from the micro-stepper
+//      (microstep.h), and each run's period is K_P * Delta_1 (seed §5) from the move's K table.
+#pragma once
+
+#include "lowlevel/fixmath.h"
+#include "lowlevel/line.h"
+#include "lowlevel/microstep.h"
+#include "lowlevel/profile.h"
+#include "lowlevel/run_queue.h"
+#include "lowlevel/waits.h"
+
+namespace ll {
+
+/// Minimum duration of a macro segment, CPU cycles. The measured cost of producing one segment
+/// on the ATmega328P (docs/motion.md) must stay well below it.
+constexpr uint16_t kSegmentCycles = 2048;
+/// Longest wait before one step (idle waits included), CPU cycles: 1.04 s. Slower steps are
+/// taken at this rate.
+constexpr uint32_t kMaxPeriodCycles = 256ul * 65000;
+
+/// One straight move as the planner hands it over.
+struct MoveSpec {
+    int32_t delta[kAxes]; ///< ticks per machine axis
+    uint32_t len_q8;      ///< length of the regulated path (axes of `group`), µm x 256
+    uint32_t accel;       ///< acceleration along the regulated path, mm/min^2
+    uint32_t feed;        ///< nominal speed along the regulated path, mm/min x1000
+    uint32_t v_entry2;    ///< entry speed squared, (mm/min)^2
+    uint32_t v_nominal2;  ///< nominal speed squared, (mm/min)^2
+    uint32_t v_exit2;     ///< exit speed squared, (mm/min)^2
+    uint8_t group;        ///< regulated axes G (bit a = machine axis a)
+};
+
+/// Counters for the benchmarks and the docs.
+struct StepGenStats {
+    uint32_t segments;
+    uint32_t runs;
+    uint32_t divisions; ///< Delta_1 = D / R evaluations (one per change of R)
+    uint32_t clamped;   ///< periods raised to the minimum period
+};
+
+class StepGen {
+  public:
+    /// `lengths` must outlive the generator; `min_period` is the shortest period the step
+    /// interrupt honours (pulse width + its own margins), CPU cycles.
+    void configure(const StepLengths* lengths, uint16_t min_period);
+
+    /// Prepares a move (seed §7: sort axes, slopes; §5: K table; §4: profile). The entry speed
+    /// is `spec.v_entry2` unless a previous move handed over its actual exit speed.
+    /// Returns false (and stays idle) for a move with no step.
+    bool begin(const MoveSpec& spec);
+    bool active() const { return active_; }
+
+    /// Produces segments into `q` while it has room for one more segment. Returns the number of
+    /// runs pushed. When the move is fully produced, active() becomes false.
+    uint8_t fill(RunQueue& q);
+
+    /// The planner raised the exit speed of the current move. Ignored once the end deceleration
+    /// has begun (the seed's profile never accelerates at the end of a move).
+    void set_exit(uint32_t v_exit2);
+
+    /// Feed hold: from the next segment on, decelerate to a stop (possibly across moves).
+    void hold();
+    bool holding() const { return holding_; }
+    /// True when a hold has brought the speed to zero: nothing more is produced until resume().
+    bool stopped() const { return stopped_; }
+    /// Resumes the current move from rest after a hold, with a new exit speed (the planner
+    /// replans the remaining path from zero speed).
+    void resume(uint32_t v_exit2);
+
+    /// Speed at the end of the last produced segment, (mm/min)^2 of the current move's path.
+    uint32_t speed2() const;
+    /// Reference ticks left in the current move, and the move's reference length.
+    uint32_t remaining() const { return line_.dist[0] - cursor_.x1; }
+    uint32_t length() const { return line_.dist[0]; }
+
+    /// Position after every run pushed so far, steps.
+    const int32_t* pushed_position() const { return pos_; }
+    void set_position(const int32_t steps[kAxes]);
+    /// Forgets the current move (soft reset); the position is kept.
+    void abort();
+
+    StepGenStats stats{};
+
+    // Exposed for the tests: the prepared move.
+    const LineGeometry& line() const { return line_; }
+    const Profile& profile() const { return prof_; }
+    /// K table: normalised wait-time factor of each axis set containing the reference axis,
+    /// indexed by (sorted-position set >> 1), Q16. Delta_P = K[P] * Delta_1 >> 16.
+    uint32_t k(uint8_t index) const { return k_[index]; }
+    uint8_t segment_ticks() const { return seg_len_; }
+
+  private:
+    void prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks);
+    void build_k_table(uint8_t group);
+    uint32_t a_of(uint32_t v2) const;
+    void emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8);
+
+    const StepLengths* lengths_ = nullptr;
+    uint16_t min_period_ = 160;
+    bool active_ = false;
+    bool holding_ = false;
+    bool stopped_ = false;
+    bool have_handover_ = false;
+    uint8_t seg_len_ = 1;
+    uint8_t decelerating_ = 0;
+
+    MoveSpec spec_{};
+    LineGeometry line_{};
+    LineCursor cursor_{};
+    Profile prof_{};
+    Ratio a_per_v2_{};    ///< A per (mm/min)^2 at the profile's scale
+    uint32_t origin_ = 0; ///< reference tick where the profile starts (moves after a resume)
+    uint32_t x2_decel_ = 0;
+    SqrtTracker root_{};
+    bool root_valid_ = false;
+    uint32_t delta_q8_ = 0;   ///< Delta_1 of the last segment, cycles x 256
+    uint32_t a_last_ = 0;     ///< A of the last segment
+    uint32_t delta_root_ = 0; ///< d_num / R for the current R
+    uint32_t kmax_ = 0;       ///< largest K of the move
+    // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
+    uint32_t a_hold_ = 0;
+    uint32_t x2_hold_ = 0;
+    uint32_t handover_v2_ = 0;
+
+    uint32_t k_[1u << (kAxes - 1)];
+    uint8_t k_mask_[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
+    int32_t pos_[kAxes] = {};
+};
+
+} // namespace ll

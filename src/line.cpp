@@ -1,0 +1,76 @@
+#include "lowlevel/line.h"
+
+#include "lowlevel/fixmath.h"
+
+namespace ll {
+
+bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
+    g.m = 0;
+    g.dirs = 0;
+    // §7.1: drop still axes, insertion-sort the rest by distance, decreasing. Ties keep the
+    // machine-axis order so that the result is deterministic.
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        int32_t d = delta[a];
+        if (d == 0) continue;
+        uint32_t dist = d < 0 ? static_cast<uint32_t>(-(d + 1)) + 1u : static_cast<uint32_t>(d);
+        if (d < 0) g.dirs = static_cast<uint8_t>(g.dirs | (1u << a));
+        uint8_t i = g.m;
+        while (i > 0 && g.dist[i - 1] < dist) {
+            g.dist[i] = g.dist[i - 1];
+            g.axis[i] = g.axis[i - 1];
+            --i;
+        }
+        g.dist[i] = dist;
+        g.axis[i] = a;
+        ++g.m;
+    }
+    if (g.m == 0 || g.dist[0] > kMaxLineTicks) return false;
+
+    // §7.2: P = 2^k, the smallest power of two with P >= 8 d_1.
+    uint32_t d1 = g.dist[0];
+    uint8_t k = 3;
+    while ((1ul << k) < 8ul * d1) ++k;
+    g.shift = k;
+    g.slope[0] = 1ul << k;
+    for (uint8_t j = 1; j < g.m; ++j) {
+        // round(d_j * 2^k / d_1) = floor((2 d_j * 2^k / d_1 + 1) / 2)
+        uint32_t twice = div_frac(g.dist[j], d1, static_cast<uint8_t>(k + 1));
+        g.slope[j] = (twice + 1) >> 1;
+    }
+    return true;
+}
+
+void line_start(const LineGeometry& g, LineCursor& c) {
+    c.x1 = 0;
+    uint32_t half = 1ul << (g.shift - 1);
+    for (uint8_t j = 0; j < g.m; ++j) {
+        c.pos[j] = 0;
+        c.frac[j] = half;
+    }
+}
+
+void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[kAxes]) {
+    c.x1 += len;
+    c.pos[0] += len;
+    e[0] = len;
+    const uint32_t mask = (1ul << g.shift) - 1;
+    if (c.x1 == g.dist[0]) {
+        // Last segment: S_j * d_1 + P/2 lands within 1/8 tick of d_j + 1/2 by construction
+        // (|d_1 (S_j / P - s_j)| <= d_1 / (2P) <= 1/16), so the formula gives d_j exactly;
+        // writing it directly also saves the multiplication.
+        for (uint8_t j = 1; j < g.m; ++j) {
+            e[j] = static_cast<uint8_t>(g.dist[j] - c.pos[j]);
+            c.pos[j] = g.dist[j];
+        }
+        return;
+    }
+    for (uint8_t j = 1; j < g.m; ++j) {
+        uint32_t acc = c.frac[j] + g.slope[j] * len; // < 2^27 + 2^27 * 16 < 2^32
+        uint8_t inc = static_cast<uint8_t>(acc >> g.shift);
+        c.frac[j] = acc & mask;
+        c.pos[j] += inc;
+        e[j] = inc;
+    }
+}
+
+} // namespace ll

@@ -1,0 +1,41 @@
+#include "lowlevel/microstep.h"
+
+namespace ll {
+
+uint8_t micro_split(const uint8_t e[], uint8_t m, MicroRun out[]) {
+    // Sorted positions 1..m-1 with a non-zero increment, ordered by increment, increasing.
+    uint8_t order[kAxes];
+    uint8_t n = 0;
+    uint8_t set = 1;
+    for (uint8_t j = 1; j < m; ++j) {
+        if (e[j] == 0) continue;
+        set = static_cast<uint8_t>(set | (1u << j));
+        uint8_t i = n;
+        while (i > 0 && e[order[i - 1]] > e[j]) {
+            order[i] = order[i - 1];
+            --i;
+        }
+        order[i] = j;
+        ++n;
+    }
+    uint8_t runs = 0;
+    uint8_t done = 0; // micro steps emitted so far
+    for (uint8_t i = 0; i < n; ++i) {
+        uint8_t j = order[i];
+        if (e[j] > done) {
+            out[runs].set = set;
+            out[runs].count = static_cast<uint8_t>(e[j] - done);
+            ++runs;
+            done = e[j];
+        }
+        set = static_cast<uint8_t>(set & ~(1u << j)); // axis j has reached its target
+    }
+    if (e[0] > done) {
+        out[runs].set = set;
+        out[runs].count = static_cast<uint8_t>(e[0] - done);
+        ++runs;
+    }
+    return runs;
+}
+
+} // namespace ll

@@ -1,0 +1,233 @@
+// The step generator: wait times per axis set (seed §3.2, §5), whole moves, feed hold.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+
+#include "motion_util.h"
+
+namespace {
+
+constexpr double kF = 16e6;
+
+// Seed §3.2 in CPU cycles: Delta_P = F_cpu * sqrt(sum_{j in P∩G} 1/T_j^2) / V, V in mm/s.
+double seed_wait(const lltest::Machine& m, uint8_t set, uint8_t group, double v_mm_s) {
+    double s = 0;
+    for (uint8_t a = 0; a < ll::kAxes; ++a) {
+        if ((set & group) & (1u << a)) s += 1.0 / (m.steps_per_mm[a] * m.steps_per_mm[a]);
+    }
+    return kF * std::sqrt(s) / v_mm_s;
+}
+
+// The speed at which the generator times a line's tick path so that the ideal line is covered
+// at `feed` (docs/motion.md, "Feed along the line"): V_eff = V * staircase / line, with the
+// staircase of the §8 run order (all axes, then all but the shortest, ...).
+double effective_speed(const lltest::Machine& m, const int32_t delta[ll::kAxes], double v) {
+    std::vector<std::pair<uint32_t, uint8_t>> d;
+    for (uint8_t a = 0; a < ll::kAxes; ++a) {
+        if (delta[a]) d.push_back({static_cast<uint32_t>(std::abs(delta[a])), a});
+    }
+    std::stable_sort(d.begin(), d.end(), [](auto x, auto y) { return x.first > y.first; });
+    double stair = 0;
+    uint8_t set = 0;
+    for (size_t i = 0; i < d.size(); ++i) {
+        set = static_cast<uint8_t>(set | (1u << d[i].second));
+        uint32_t n = d[i].first - (i + 1 < d.size() ? d[i + 1].first : 0);
+        stair += n * seed_wait(m, set, 0xFF, 1.0) / kF;
+    }
+    return v * stair / m.length_mm(delta);
+}
+
+} // namespace
+
+TEST(Waits, TabulatedStepLengthsGiveTheSeedFormulaWithinOneCycle) {
+    const double spm[] = {5, 40, 80, 100, 160, 250, 400, 800, 1600, 3200};
+    const double feeds[] = {30, 300, 1000, 3000, 12000, 60000}; // mm/min
+    double worst = 0;
+    for (double tx : spm) {
+        for (double ty : spm) {
+            lltest::Machine m{tx, ty, 400, 100};
+            for (double f : feeds) {
+                for (uint8_t set = 1; set < 16; ++set) {
+                    double want = seed_wait(m, set, 0xFF, f / 60);
+                    if (want > 65535 * 4) continue; // long waits are split into idle runs
+                    uint32_t got = ll::wait_q8(m.lengths, set, 0xFF,
+                                               static_cast<uint32_t>(std::lround(f * 1000)));
+                    double err = std::fabs(got / 256.0 - want);
+                    worst = std::max(worst, err);
+                    ASSERT_LE(err, 1.0)
+                        << "T=" << tx << "," << ty << " F" << f << " set " << int(set);
+                }
+            }
+        }
+    }
+    std::printf("worst |Delta_P - seed §3.2| = %.3f cycle\n", worst);
+}
+
+TEST(Waits, OnlyTheRegulatedGroupCountsInTheWaitTime) {
+    lltest::Machine m{80, 80, 400, 10};
+    // X+A regulated on XYZ: the A part of the diagonal adds no time.
+    uint32_t xa = ll::wait_q8(m.lengths, 0b1001, 0b0111, 600000);
+    uint32_t x = ll::wait_q8(m.lengths, 0b0001, 0b0111, 600000);
+    EXPECT_EQ(xa, x);
+    EXPECT_NEAR(x / 256.0, seed_wait(m, 1, 0xFF, 10), 1.0);
+}
+
+TEST(StepGen, CruiseRunsFollowTheSeedWaitTimesAtTheCompensatedSpeed) {
+    // Every run at cruise lasts K_P * Delta_1 = seed §3.2 at V_eff within one cycle.
+    std::mt19937 rng(7);
+    const double spm[] = {5, 80, 100, 250, 400, 800, 3200};
+    double worst = 0;
+    for (int i = 0; i < 400; ++i) {
+        lltest::Machine m{spm[rng() % 7], spm[rng() % 7], spm[rng() % 7], spm[rng() % 7]};
+        int32_t delta[ll::kAxes];
+        for (auto& d : delta) d = static_cast<int32_t>(rng() % 3000) - 1500;
+        double feed = 100 + rng() % 6000;
+        ll::MoveSpec spec = m.move({delta[0], delta[1], delta[2], delta[3]}, feed, 100000, feed,
+                                   feed); // entry = exit = cruise: cruise throughout
+        if (spec.len_q8 == 0) continue;
+        ll::StepGen gen;
+        gen.configure(&m.lengths, 64);
+        auto ev = lltest::run_move(gen, spec);
+        double veff = effective_speed(m, spec.delta, feed / 60);
+        for (const auto& e : ev) {
+            if (e.period == 0xFFFF || e.period < 65) continue;
+            double want = seed_wait(m, e.steps, 0xFF, veff);
+            if (want > 65000) continue; // split into idle waits: checked separately
+            double err = std::fabs(e.period - want);
+            worst = std::max(worst, err);
+            ASSERT_LE(err, 1.0) << "move " << i << " set " << int(e.steps);
+        }
+    }
+    std::printf("worst |period - seed §3.2 at V_eff| = %.3f cycle\n", worst);
+}
+
+TEST(StepGen, MovesEndExactlyOnTheirTargetWithEveryAxisStepCounted) {
+    std::mt19937 rng(11);
+    lltest::Machine m{80, 80, 400, 40};
+    for (int i = 0; i < 300; ++i) {
+        int32_t delta[ll::kAxes];
+        for (auto& d : delta) d = static_cast<int32_t>(rng() % 20001) - 10000;
+        ll::MoveSpec spec =
+            m.move({delta[0], delta[1], delta[2], delta[3]}, 500 + rng() % 5000, 50 + rng() % 2000);
+        ll::StepGen gen;
+        gen.configure(&m.lengths, 64);
+        auto ev = lltest::run_move(gen, spec);
+        int32_t pos[ll::kAxes] = {};
+        for (const auto& e : ev) {
+            for (uint8_t a = 0; a < ll::kAxes; ++a) {
+                if (e.steps & (1u << a)) pos[a] += (e.dirs & (1u << a)) ? -1 : 1;
+            }
+        }
+        for (uint8_t a = 0; a < ll::kAxes; ++a) {
+            ASSERT_EQ(pos[a], delta[a]);
+            ASSERT_EQ(gen.pushed_position()[a], delta[a]);
+        }
+    }
+}
+
+TEST(StepGen, DiagonalLinesTakeLengthOverFeedNotTheStaircaseTime) {
+    // Without the compensation a 22.5-degree line would take 8% longer than len / V.
+    lltest::Machine m{80, 80};
+    for (int32_t dy : {0, 3314, 4000, 8000}) {
+        ll::MoveSpec spec = m.move({8000, dy}, 1200, 1e6, 1200, 1200);
+        ll::StepGen gen;
+        gen.configure(&m.lengths, 64);
+        uint64_t t = 0;
+        lltest::run_move(gen, spec, &t);
+        double want = m.length_mm(spec.delta) / 20.0 * kF; // 1200 mm/min = 20 mm/s
+        EXPECT_NEAR(static_cast<double>(t) / want, 1.0, 2e-4) << "dy=" << dy;
+    }
+}
+
+TEST(StepGen, SlowMovesUseIdleWaitsAndKeepTheirTiming) {
+    // 5 steps/mm at 6 mm/min: 0.5 step/s, 32 M cycles per step, far above the 16-bit timer.
+    lltest::Machine m{5};
+    ll::MoveSpec spec = m.move({3}, 6, 1e6, 6, 6);
+    ll::StepGen gen;
+    gen.configure(&m.lengths, 64);
+    ll::RunQueue q;
+    q.clear();
+    ASSERT_TRUE(gen.begin(spec));
+    uint64_t t = 0;
+    std::vector<uint64_t> steps;
+    while (gen.active() || !q.empty()) {
+        gen.fill(q);
+        while (!q.empty()) {
+            ll::Run r = q.front();
+            q.pop();
+            ASSERT_GE(r.period, 64);
+            for (uint8_t i = 0; i < r.count; ++i) {
+                t += r.period;
+                if (r.steps) steps.push_back(t);
+            }
+        }
+    }
+    ASSERT_EQ(steps.size(), 3u);
+    // Waits are capped at kMaxPeriodCycles (1.04 s): slower moves run at about 1 step/s.
+    EXPECT_EQ(steps[1] - steps[0], ll::kMaxPeriodCycles);
+}
+
+TEST(StepGen, PeriodsNeverGoBelowTheMinimumThePulseNeeds) {
+    lltest::Machine m{800};
+    ll::MoveSpec spec = m.move({20000}, 30000, 1e5); // 400 kHz asked
+    ll::StepGen gen;
+    gen.configure(&m.lengths, 200);
+    auto ev = lltest::run_move(gen, spec);
+    for (const auto& e : ev) ASSERT_GE(e.period, 200);
+    EXPECT_GT(gen.stats.clamped, 0u);
+}
+
+TEST(StepGen, FeedHoldStopsAlongThePathAndResumeFinishesTheMove) {
+    lltest::Machine m{80, 80};
+    ll::MoveSpec spec = m.move({16000, 8000}, 3000, 500);
+    ll::StepGen gen;
+    gen.configure(&m.lengths, 64);
+    ll::RunQueue q;
+    q.clear();
+    ASSERT_TRUE(gen.begin(spec));
+    int32_t pos[2] = {0, 0};
+    uint64_t t = 0;
+    std::vector<std::pair<uint64_t, uint32_t>> x_steps; // time, axis-0 position
+    auto drain = [&] {
+        while (!q.empty()) {
+            ll::Run r = q.front();
+            q.pop();
+            for (uint8_t i = 0; i < r.count; ++i) {
+                t += r.period;
+                if (r.steps & 1) {
+                    ++pos[0];
+                    x_steps.push_back({t, static_cast<uint32_t>(pos[0])});
+                }
+                if (r.steps & 2) ++pos[1];
+            }
+        }
+    };
+    while (gen.active() && pos[0] < 8000) {
+        gen.fill(q);
+        drain();
+    }
+    gen.hold();
+    while (gen.active() && !gen.stopped()) {
+        gen.fill(q);
+        drain();
+    }
+    ASSERT_TRUE(gen.stopped());
+    // Stopped inside the move, after decelerating: the last steps are slow.
+    EXPECT_LT(pos[0], 16000);
+    size_t n = x_steps.size();
+    double last_rate = kF / static_cast<double>(x_steps[n - 1].first - x_steps[n - 2].first);
+    EXPECT_LT(last_rate, 0.1 * 4000); // below 10% of the cruise step rate
+    // Deceleration distance at 500 mm/s^2 from 50 mm/s: 2.5 mm = 200 ticks, plus the queue.
+    EXPECT_LT(pos[0] - 8000, 200 + 16 * 32);
+    gen.resume(0);
+    while (gen.active()) {
+        gen.fill(q);
+        drain();
+    }
+    drain();
+    EXPECT_EQ(pos[0], 16000);
+    EXPECT_EQ(pos[1], 8000);
+}
