@@ -210,7 +210,11 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8
     }
     if (period > kMaxPeriodCycles) period = kMaxPeriodCycles;
     const uint8_t dirs = line_.dirs;
+    uint32_t units = (period * count) >> 10;
+    uint8_t slot_units = units > 255 ? 255 : static_cast<uint8_t>(units);
     if (period <= 0xFFFF) {
+        slot_time_[q.tail] = slot_units;
+        queued_ = static_cast<uint16_t>(queued_ + slot_units);
         q.push(Run{steps, dirs, count, static_cast<uint16_t>(period)});
         ++stats.runs;
     } else {
@@ -220,8 +224,11 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8
         uint16_t each = static_cast<uint16_t>(period / parts);
         uint16_t last = static_cast<uint16_t>(period - (parts - 1) * each);
         for (uint8_t i = 0; i < count; ++i) {
+            slot_time_[q.tail] = 255;
             q.push(Run{0, dirs, static_cast<uint8_t>(parts - 1), each});
+            slot_time_[q.tail] = 63;
             q.push(Run{steps, dirs, 1, last});
+            queued_ = static_cast<uint16_t>(queued_ + 255 + 63);
             stats.runs += 2;
         }
     }
@@ -236,11 +243,28 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8
     }
 }
 
+uint32_t StepGen::queued_cycles(const RunQueue& q) {
+    // Runs the interrupt has taken since the last look no longer count.
+    uint8_t head = q.head;
+    while (seen_head_ != head) {
+        queued_ = static_cast<uint16_t>(queued_ - slot_time_[seen_head_]);
+        seen_head_ = static_cast<uint8_t>((seen_head_ + 1) & (kRunQueueSize - 1));
+    }
+    return static_cast<uint32_t>(queued_) << 10;
+}
+
+void StepGen::clear_queue_time() {
+    queued_ = 0;
+    seen_head_ = 0;
+}
+
 uint8_t StepGen::fill(RunQueue& q) {
     uint8_t pushed_before = q.used();
     while (active_ && !stopped_) {
-        // Room for the worst case of one segment: m runs, each possibly split in two.
+        // Room for the worst case of one segment: m runs, each possibly split in two; and no
+        // more than the horizon committed ahead of the interrupt.
         if (q.free_slots() < 2 * line_.m) break;
+        if (queued_cycles(q) >= kHorizonCycles) break;
         uint32_t left = line_.dist[0] - cursor_.x1;
         uint8_t len = left < seg_len_ ? static_cast<uint8_t>(left) : seg_len_;
         uint32_t x2 = 2 * (cursor_.x1 - origin_) + len; // segment midpoint, half ticks

@@ -15,6 +15,10 @@ struct LineRequest {
     bool rapid;                  ///< G0: as fast as every axis allows
 };
 
+/// Power-up state: position zero, nothing queued, step timer stopped. Call once before
+/// settings_changed().
+void init();
+
 /// True when the planner has room for one more move.
 bool can_accept();
 /// Queues a move. Precondition: can_accept(). A move of zero length is dropped silently (as
@@ -51,5 +55,12 @@ uint32_t current_feed();
 /// The settings changed: recompute derived tables. Only called while state() == Idle.
 void settings_changed();
 
+} // namespace motion
+} // namespace ll
+
+namespace ll {
+namespace motion {
+/// Times the step queue ran dry in the middle of a move since power-up (benchmarks).
+uint32_t starvations();
 } // namespace motion
 } // namespace ll

@@ -23,6 +23,12 @@ namespace ll {
 /// Minimum duration of a macro segment, CPU cycles. The measured cost of producing one segment
 /// on the ATmega328P (docs/motion.md) must stay well below it.
 constexpr uint16_t kSegmentCycles = 2048;
+/// How far ahead of the step interrupt the generator commits motion, CPU cycles (4 ms). Motion
+/// not yet produced can still be replanned (a later move raising this one's exit speed, a feed
+/// hold), so the generator stays this close behind the interrupt; the main loop must come back
+/// to poll() within this time, which is the budget of the compute windows (docs/motion.md).
+constexpr uint32_t kHorizonCycles = 64000;
+
 /// Longest wait before one step (idle waits included), CPU cycles: 1.04 s. Slower steps are
 /// taken at this rate.
 constexpr uint32_t kMaxPeriodCycles = 256ul * 65000;
@@ -59,9 +65,15 @@ class StepGen {
     bool begin(const MoveSpec& spec);
     bool active() const { return active_; }
 
-    /// Produces segments into `q` while it has room for one more segment. Returns the number of
-    /// runs pushed. When the move is fully produced, active() becomes false.
+    /// Produces segments into `q` while it has room for one more segment and holds less than
+    /// kHorizonCycles of motion. Returns the number of runs pushed. When the move is fully
+    /// produced, active() becomes false.
     uint8_t fill(RunQueue& q);
+
+    /// Motion queued ahead of the interrupt, CPU cycles (1024-cycle resolution).
+    uint32_t queued_cycles(const RunQueue& q);
+    /// Forget the queued-time accounting (the queue was cleared).
+    void clear_queue_time();
 
     /// The planner raised the exit speed of the current move. Ignored once the end deceleration
     /// has begun (the seed's profile never accelerates at the end of a move).
@@ -130,6 +142,12 @@ class StepGen {
     uint32_t a_hold_ = 0;
     uint32_t x2_hold_ = 0;
     uint32_t handover_v2_ = 0;
+
+    // Duration of each queued run in 1024-cycle units (saturated), by queue slot, and their
+    // sum: lets fill() keep the horizon without any help from the interrupt.
+    uint8_t slot_time_[kRunQueueSize] = {};
+    uint16_t queued_ = 0;
+    uint8_t seen_head_ = 0;
 
     uint32_t k_[1u << (kAxes - 1)];
     uint8_t k_mask_[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set

@@ -1,0 +1,32 @@
+// What the motion side derives from the settings once per change, so that a move costs no
+// division by a setting: step lengths per axis set (seed §3.2), length per step, limits in the
+// planner's units, speed groups (seed §3.1).
+#pragma once
+
+#include "lowlevel/fixmath.h"
+#include "lowlevel/settings.h"
+#include "lowlevel/waits.h"
+
+namespace ll {
+
+struct Machine {
+    StepLengths lengths;
+    Ratio um_q8_per_step[kAxes]; ///< µm x 256 travelled per step (1 / T_a)
+    uint32_t max_rate[kAxes];    ///< units/min x1000
+    uint32_t accel[kAxes];       ///< units/min^2
+    uint8_t group_of[kAxes];     ///< axis bits sharing axis a's speed group
+    uint32_t junction_dev_um;    ///< $11, µm
+    uint16_t min_period;         ///< shortest step period the interrupt honours, CPU cycles
+};
+
+/// Extra cycles the step interrupt needs beyond the pulse width between two steps (pulse-end
+/// interrupt latency and direction setup), from the firmware's measurements.
+constexpr uint16_t kPeriodMargin = 48;
+
+void machine_build(Machine& m, const Settings& s);
+
+/// The regulated group of a move (seed §3.1, LinuxCNC/g2core rule): the group of the first
+/// moving axis in X, Y, Z, A, B, C order. 0 when nothing moves.
+uint8_t regulated_group(const Machine& m, const int32_t delta_steps[kAxes]);
+
+} // namespace ll

@@ -1,0 +1,36 @@
+#include "lowlevel/machine.h"
+
+namespace ll {
+
+void machine_build(Machine& m, const Settings& s) {
+    uint32_t spm[kAxes];
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        const AxisSettings& ax = s.axis[a];
+        spm[a] = ax.steps_per_unit < 1000 ? 1000 : ax.steps_per_unit;
+        m.um_q8_per_step[a] = make_ratio(256000000ull, spm[a]);
+        m.max_rate[a] = ax.max_rate;
+        // mm/s^2 x1000 -> mm/min^2: x 3600 / 1000
+        m.accel[a] = saturate32(static_cast<uint64_t>(ax.accel) * 18 / 5);
+        if (m.accel[a] == 0) m.accel[a] = 1;
+    }
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        uint8_t mask = 0;
+        for (uint8_t b = 0; b < kAxes; ++b) {
+            if (s.axis_group[b] == s.axis_group[a]) mask = static_cast<uint8_t>(mask | (1u << b));
+        }
+        m.group_of[a] = mask;
+    }
+    step_lengths_build(m.lengths, spm);
+    m.junction_dev_um = s.junction_dev;
+    uint32_t minp = static_cast<uint32_t>(s.pulse_us) * (kCpuHz / 1000000) + kPeriodMargin;
+    m.min_period = static_cast<uint16_t>(minp > 0xFFFF ? 0xFFFF : minp);
+}
+
+uint8_t regulated_group(const Machine& m, const int32_t delta_steps[kAxes]) {
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        if (delta_steps[a] != 0) return m.group_of[a];
+    }
+    return 0;
+}
+
+} // namespace ll

@@ -1,0 +1,282 @@
+// motion.h on top of the planner, the step generator and the run queue.
+#include "lowlevel/motion.h"
+
+#include "lowlevel/hal.h"
+#include "lowlevel/planner.h"
+#include "lowlevel/run_queue.h"
+#include "lowlevel/settings.h"
+#include "lowlevel/stepgen.h"
+
+namespace ll {
+namespace motion {
+namespace {
+
+struct Motion {
+    Machine machine;
+    Planner planner;
+    StepGen gen;
+    State state = State::Idle;
+    bool begun = false;      ///< the planner's first move is in the step generator
+    bool enabled = false;    ///< stepper drivers enabled
+    uint32_t idle_since = 0; ///< hal::millis() when motion last stopped
+    // A move longer than kMaxLineTicks on one axis is queued in pieces: what is left of it.
+    bool split_pending = false;
+    LineRequest split;
+    uint32_t starvations = 0;
+};
+
+Motion& mo() {
+    static Motion m;
+    return m;
+}
+
+void begin_next(Motion& m) {
+    while (!m.begun && !m.planner.empty()) {
+        if (m.gen.begin(m.planner.spec_of_first())) {
+            m.planner.begin_first();
+            m.begun = true;
+        } else {
+            m.planner.discard_first();
+        }
+    }
+}
+
+void produce(Motion& m) {
+    for (;;) {
+        begin_next(m);
+        if (!m.begun) return;
+        m.gen.set_exit(m.planner.exit2_of_first());
+        m.gen.fill(g_runs);
+        if (m.gen.active() || m.gen.stopped()) return; // queue full, or held
+        m.planner.discard_first();
+        m.begun = false;
+    }
+}
+
+bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        int64_t d = static_cast<int64_t>(to[a]) - from[a];
+        if (d > static_cast<int64_t>(kMaxLineTicks) || -d > static_cast<int64_t>(kMaxLineTicks)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Queues as much of `req` as one block can take; true when all of it went in.
+bool queue_piece(Motion& m, const LineRequest& req) {
+    const int32_t* from = m.planner.last_target();
+    if (!too_long(from, req.target_steps)) {
+        m.planner.add(req.target_steps, req.target_um, req.feed, req.rapid);
+        return true;
+    }
+    // Halve the remaining travel until it fits: pieces end on exact step targets, and the last
+    // piece ends on the requested target, so nothing accumulates.
+    const int32_t* from_um = m.planner.last_target_um();
+    int32_t mid[kAxes], mid_um[kAxes];
+    int64_t den = 2;
+    for (;;) {
+        for (uint8_t a = 0; a < kAxes; ++a) {
+            int64_t d = static_cast<int64_t>(req.target_steps[a]) - from[a];
+            mid[a] = static_cast<int32_t>(from[a] + d / den);
+            int64_t du = static_cast<int64_t>(req.target_um[a]) - from_um[a];
+            mid_um[a] = static_cast<int32_t>(from_um[a] + du / den);
+        }
+        if (!too_long(from, mid)) break;
+        den *= 2;
+    }
+    m.planner.add(mid, mid_um, req.feed, req.rapid);
+    return false;
+}
+
+// The commanded position that matches a machine position in steps, mm x1000 (after an abort
+// the machine is between targets; the next move's direction is taken from here).
+const int32_t* position_um(Motion& m, const int32_t steps[kAxes]) {
+    static int32_t um[kAxes];
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        int32_t s = steps[a];
+        uint32_t mag = s < 0 ? static_cast<uint32_t>(-(s + 1)) + 1u : static_cast<uint32_t>(s);
+        int32_t v = static_cast<int32_t>(m.machine.um_q8_per_step[a].apply(mag) >> 8);
+        um[a] = s < 0 ? -v : v;
+    }
+    return um;
+}
+
+void enable(Motion& m, bool on) {
+    if (m.enabled == on) return;
+    m.enabled = on;
+    hal::stepper_enable(on);
+}
+
+} // namespace
+
+void init() {
+    Motion& m = mo();
+    hal::stepper_stop();
+    g_runs.clear();
+    m.gen.clear_queue_time();
+    g_exec.starved = 0;
+    int32_t zero[kAxes] = {};
+    m.gen.abort();
+    m.gen.set_position(zero);
+    m.planner.reset(zero, zero);
+    m.begun = false;
+    m.split_pending = false;
+    m.enabled = false;
+    m.state = State::Idle;
+    m.starvations = 0;
+}
+
+bool can_accept() {
+    return !mo().planner.full() && !mo().split_pending;
+}
+
+void push_line(const LineRequest& req) {
+    Motion& m = mo();
+    if (!queue_piece(m, req)) {
+        m.split_pending = true;
+        m.split = req;
+    }
+    if (!m.planner.empty() && m.state == State::Idle) m.state = State::Cycle;
+    poll();
+}
+
+uint8_t blocks_free() {
+    return static_cast<uint8_t>(kPlannerSize - mo().planner.count());
+}
+
+void poll() {
+    Motion& m = mo();
+    while (m.split_pending && !m.planner.full()) {
+        if (queue_piece(m, m.split)) m.split_pending = false;
+    }
+    if (m.state == State::Idle && m.planner.empty() && g_runs.empty() && !g_exec.running) {
+        if (m.enabled && g_settings.idle_delay_ms != 255 &&
+            hal::millis() - m.idle_since >= g_settings.idle_delay_ms) {
+            enable(m, false);
+        }
+        return;
+    }
+    produce(m);
+    if (!g_exec.running) {
+        if (g_exec.starved && (m.begun || !m.planner.empty()) && !m.gen.stopped()) {
+            ++m.starvations; // the queue ran dry in the middle of a move
+        }
+        g_exec.starved = 0;
+        if (!g_runs.empty() && m.state != State::Held) {
+            enable(m, true);
+            hal::stepper_start();
+        }
+    }
+    bool drained = g_runs.empty() && !g_exec.running;
+    if (m.state == State::Holding) {
+        if (drained && (m.gen.stopped() || (!m.begun && m.planner.empty()))) m.state = State::Held;
+    } else if (m.state == State::Cycle) {
+        if (drained && !m.begun && m.planner.empty() && !m.split_pending) {
+            m.state = State::Idle;
+            m.idle_since = hal::millis();
+        }
+    }
+}
+
+State state() {
+    return mo().state;
+}
+
+void feed_hold() {
+    Motion& m = mo();
+    if (m.state != State::Cycle) return;
+    m.gen.hold();
+    m.state = State::Holding;
+    poll();
+}
+
+void cycle_start() {
+    Motion& m = mo();
+    if (m.state != State::Held) return;
+    if (m.begun && m.gen.stopped()) {
+        m.planner.restart_first(m.gen.remaining(), m.gen.length());
+        m.gen.resume(m.planner.exit2_of_first());
+    } else {
+        m.gen.resume(0);
+    }
+    m.state = (m.begun || !m.planner.empty()) ? State::Cycle : State::Idle;
+    if (m.state == State::Idle) m.idle_since = hal::millis();
+    poll();
+}
+
+bool abort() {
+    Motion& m = mo();
+    bool moving = g_exec.running != 0;
+    int32_t here[kAxes];
+    position(here);
+    hal::stepper_stop();
+    g_runs.clear();
+    m.gen.clear_queue_time();
+    g_exec.starved = 0;
+    m.gen.abort();
+    m.gen.set_position(here);
+    m.planner.reset(here, position_um(m, here));
+    m.begun = false;
+    m.split_pending = false;
+    m.state = State::Idle;
+    m.idle_since = hal::millis();
+    return moving;
+}
+
+void position(int32_t steps[kAxes]) {
+    Motion& m = mo();
+    uint8_t head, remaining, cur_steps, cur_dirs;
+    {
+        hal::Critical cs;
+        head = g_runs.head;
+        remaining = g_exec.remaining;
+        cur_steps = g_exec.steps;
+        cur_dirs = g_exec.dirs;
+    }
+    const int32_t* pushed = m.gen.pushed_position();
+    for (uint8_t a = 0; a < kAxes; ++a) steps[a] = pushed[a];
+    // Undo what is queued but not executed: the rest of the current run, then every run
+    // between the consumer and the producer.
+    auto undo = [&](uint8_t s, uint8_t d, uint8_t n) {
+        for (uint8_t a = 0; a < kAxes; ++a) {
+            if (s & (1u << a)) steps[a] += (d & (1u << a)) ? n : -static_cast<int32_t>(n);
+        }
+    };
+    undo(cur_steps, cur_dirs, remaining);
+    for (uint8_t i = head; i != g_runs.tail;
+         i = static_cast<uint8_t>((i + 1) & (kRunQueueSize - 1))) {
+        const Run& r = g_runs.buf[i];
+        undo(r.steps, r.dirs, r.count);
+    }
+}
+
+uint32_t current_feed() {
+    Motion& m = mo();
+    if (m.state == State::Idle || m.state == State::Held) return 0;
+    return isqrt32(m.gen.speed2());
+}
+
+void settings_changed() {
+    Motion& m = mo();
+    machine_build(m.machine, g_settings);
+    m.planner.configure(&m.machine);
+    m.gen.configure(&m.machine.lengths, m.machine.min_period);
+    hal::StepperConfig cfg;
+    cfg.pulse_cycles = static_cast<uint16_t>(g_settings.pulse_us * (kCpuHz / 1000000));
+    cfg.step_invert = g_settings.step_invert;
+    cfg.dir_invert = g_settings.dir_invert;
+    cfg.enable_invert = g_settings.enable_invert;
+    hal::stepper_configure(cfg);
+    int32_t here[kAxes];
+    position(here);
+    m.planner.reset(here, position_um(m, here));
+    if (g_settings.idle_delay_ms == 255) enable(m, true);
+}
+
+uint32_t starvations() {
+    return mo().starvations;
+}
+
+} // namespace motion
+} // namespace ll

@@ -1,0 +1,140 @@
+// Whole motion pipeline on the host model: motion API in, recorded pin edges out.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "motion_host.h"
+
+using ll::motion::State;
+
+namespace {
+
+struct MotionTest : ::testing::Test {
+    ll::Settings s;
+    void SetUp() override {
+        lltest::default_settings(s);
+        lltest::reset_motion(s);
+    }
+};
+
+} // namespace
+
+TEST_F(MotionTest, RandomMovesEndExactlyWhereTheEdgesSayTheyAre) {
+    std::mt19937 rng(3);
+    double x = 0, y = 0, z = 0;
+    for (int i = 0; i < 40; ++i) {
+        x = (static_cast<int>(rng() % 4000) - 2000) / 100.0;
+        y = (static_cast<int>(rng() % 4000) - 2000) / 100.0;
+        z = (static_cast<int>(rng() % 400) - 200) / 100.0;
+        lltest::line_to({x, y, z, 0}, 500 + rng() % 5000);
+    }
+    ASSERT_TRUE(lltest::run_until(State::Idle));
+    int32_t pos[ll::kAxes], edges[ll::kAxes];
+    ll::motion::position(pos);
+    lltest::count_steps(edges);
+    EXPECT_EQ(pos[0], std::lround(x * 80));
+    EXPECT_EQ(pos[1], std::lround(y * 80));
+    EXPECT_EQ(pos[2], std::lround(z * 80));
+    for (uint8_t a = 0; a < ll::kAxes; ++a) EXPECT_EQ(edges[a], pos[a]);
+    EXPECT_EQ(ll::motion::starvations(), 0u);
+}
+
+TEST_F(MotionTest, PositionDuringMotionCountsOnlyExecutedSteps) {
+    lltest::line_to({100, 50, 0, 0}, 3000);
+    for (int k = 0; k < 5; ++k) {
+        lltest::run_for(16000000 / 5); // 0.2 s
+        int32_t pos[ll::kAxes], edges[ll::kAxes];
+        ll::motion::position(pos);
+        lltest::count_steps(edges);
+        for (uint8_t a = 0; a < ll::kAxes; ++a) EXPECT_EQ(pos[a], edges[a]) << "axis " << int(a);
+    }
+}
+
+TEST_F(MotionTest, FeedHoldStopsAlongThePathLosesNoStepAndResumes) {
+    lltest::line_to({100, 50, 0, 0}, 3000);
+    lltest::line_to({150, 20, 0, 0}, 3000);
+    lltest::run_for(16000000); // 1 s into the first move
+    ll::motion::feed_hold();
+    EXPECT_EQ(ll::motion::state(), State::Holding);
+    ASSERT_TRUE(lltest::run_until(State::Held));
+    int32_t held[ll::kAxes];
+    ll::motion::position(held);
+    // Decelerating from 50 mm/s at 1000 mm/s^2 takes 1.25 mm: stopped on the first line,
+    // near 50 mm along it.
+    double along = std::hypot(held[0] / 80.0, held[1] / 80.0);
+    EXPECT_GT(along, 48.0);
+    EXPECT_LT(along, 53.0);
+    EXPECT_NEAR(held[1] * 2.0, held[0], 2.0); // on the line y = x / 2
+    // Nothing moves while held.
+    size_t edges_at_hold = ll::host::edges().size();
+    ll::host::advance_to(ll::host::now() + 16000000);
+    ll::motion::poll();
+    EXPECT_EQ(ll::host::edges().size(), edges_at_hold);
+    ll::motion::cycle_start();
+    ASSERT_TRUE(lltest::run_until(State::Idle));
+    int32_t pos[ll::kAxes], edges[ll::kAxes];
+    ll::motion::position(pos);
+    lltest::count_steps(edges);
+    EXPECT_EQ(pos[0], 150 * 80);
+    EXPECT_EQ(pos[1], 20 * 80);
+    EXPECT_EQ(edges[0], 150 * 80);
+    EXPECT_EQ(edges[1], 20 * 80);
+}
+
+TEST_F(MotionTest, ShortSegmentCircleRunsAtFullFeed) {
+    // The benchmark's circle: radius 10 mm, 0.1 mm chords, F3000, 1000 mm/s^2.
+    const double r = 10, pi = std::acos(-1.0);
+    const int n = static_cast<int>(std::lround(2 * pi * r / 0.1));
+    lltest::line_to({r, 0, 0, 0}, 3000, true);
+    ASSERT_TRUE(lltest::run_until(State::Idle));
+    uint64_t start = ll::host::now();
+    for (int i = 1; i <= n; ++i) {
+        double t = 2 * pi * i / n;
+        lltest::line_to({r * std::cos(t), r * std::sin(t), 0, 0}, 3000);
+    }
+    ASSERT_TRUE(lltest::run_until(State::Idle));
+    // The last step edge ends the motion.
+    uint64_t end = ll::host::edges().back().cycle;
+    double seconds = static_cast<double>(end - start) / 16e6;
+    double ideal = 2 * pi * r / 50.0 + 50.0 / 1000.0; // cruise + accel/decel (v/a)
+    std::printf("circle of %d segments: %.4f s, ideal %.4f s (x%.3f)\n", n, seconds, ideal,
+                seconds / ideal);
+    EXPECT_LT(seconds, 1.02 * ideal);
+    EXPECT_EQ(ll::motion::starvations(), 0u);
+}
+
+TEST_F(MotionTest, AbortStopsAtOnceAndKeepsTheExecutedPosition) {
+    lltest::line_to({100, 0, 0, 0}, 3000);
+    lltest::run_for(16000000 / 2);
+    EXPECT_TRUE(ll::motion::abort());
+    int32_t pos[ll::kAxes], edges[ll::kAxes];
+    ll::motion::position(pos);
+    lltest::count_steps(edges);
+    EXPECT_EQ(pos[0], edges[0]);
+    EXPECT_GT(pos[0], 0);
+    EXPECT_LT(pos[0], 8000);
+    EXPECT_EQ(ll::motion::state(), State::Idle);
+    // The next move starts from where the machine really is.
+    lltest::line_to({10, 0, 0, 0}, 3000);
+    ASSERT_TRUE(lltest::run_until(State::Idle));
+    ll::motion::position(pos);
+    lltest::count_steps(edges);
+    EXPECT_EQ(pos[0], 800);
+    EXPECT_EQ(edges[0], 800);
+}
+
+TEST_F(MotionTest, DriversAreEnabledWhileMovingAndReleasedAfterTheIdleDelay) {
+    lltest::line_to({1, 0, 0, 0}, 3000);
+    ASSERT_TRUE(lltest::run_until(State::Idle));
+    const auto& e = ll::host::edges();
+    ASSERT_FALSE(e.empty());
+    EXPECT_EQ(e.front().kind, ll::host::EdgeKind::Enable);
+    EXPECT_EQ(e.front().level, 0); // active low
+    uint64_t stop = ll::host::now();
+    ll::host::advance_to(stop + 16000ull * 30);
+    ll::motion::poll();
+    EXPECT_EQ(ll::host::edges().back().kind, ll::host::EdgeKind::Enable);
+    EXPECT_EQ(ll::host::edges().back().level, 1);
+    EXPECT_GE(ll::host::edges().back().cycle - stop, 16000ull * 25);
+}
