@@ -18,22 +18,6 @@ uint16_t isqrt32(uint32_t v) {
     return static_cast<uint16_t>(res);
 }
 
-uint32_t isqrt64(uint64_t v) {
-    uint64_t res = 0;
-    uint64_t one = 1ull << 62;
-    while (one > v) one >>= 2;
-    while (one != 0) {
-        if (v >= res + one) {
-            v -= res + one;
-            res = (res >> 1) + one;
-        } else {
-            res >>= 1;
-        }
-        one >>= 2;
-    }
-    return static_cast<uint32_t>(res);
-}
-
 uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits) {
     uint32_t q = num / den;
     uint32_t rem = num - q * den;
@@ -48,62 +32,160 @@ uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits) {
     return q;
 }
 
-uint8_t bit_length(uint64_t v) {
-    uint8_t n = 0;
-    while (v != 0) {
-        v >>= 1;
-        ++n;
+uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift) {
+    uint64_t p = static_cast<uint64_t>(a) * b;
+    p >>= shift;
+    return p > 0xFFFFFFFFull ? 0xFFFFFFFFul : static_cast<uint32_t>(p);
+}
+
+uint32_t shl_sat(uint32_t x, uint8_t k) {
+    if (k >= 32) return x ? 0xFFFFFFFFul : 0;
+    return x > (0xFFFFFFFFul >> k) ? 0xFFFFFFFFul : x << k;
+}
+
+namespace {
+
+// floor(hi * 2^32 / d) for hi < d, d >= 2^31: the 32 quotient bits of a normalised division.
+uint32_t div_hi(uint32_t hi, uint32_t d) {
+    uint32_t q = 0;
+    for (uint8_t i = 0; i < 32; ++i) {
+        bool carry = (hi & 0x80000000ul) != 0;
+        hi <<= 1;
+        q <<= 1;
+        if (carry || hi >= d) {
+            hi -= d;
+            q |= 1;
+        }
+    }
+    return q;
+}
+
+} // namespace
+
+namespace {
+
+// Exponents live in [-128, 127]: values beyond 2^158 saturate, below 2^-97 become zero.
+Num& finish(Num& n, uint32_t m, int16_t ex) {
+    if (ex > 127) {
+        n.m = 0xFFFFFFFFul;
+        n.e = 127;
+    } else if (ex < -128) {
+        n.m = 0;
+        n.e = 0;
+    } else {
+        n.m = m;
+        n.e = static_cast<int8_t>(ex);
     }
     return n;
 }
 
-uint32_t Ratio::apply(uint32_t x) const {
-    return saturate32(apply64(x));
+} // namespace
+
+Num& Num::set(uint32_t v, int8_t exp) {
+    if (v == 0) {
+        m = 0;
+        e = 0;
+        return *this;
+    }
+    int16_t ex = exp;
+    while (!(v & 0x80000000ul)) {
+        v <<= 1;
+        --ex;
+    }
+    return finish(*this, v, ex);
 }
 
-uint64_t Ratio::apply64(uint32_t x) const {
-    uint64_t p = static_cast<uint64_t>(x) * mant;
-    if (shift >= 0) return shift >= 64 ? 0 : p >> shift;
-    uint8_t left = static_cast<uint8_t>(-shift);
-    if (left >= 64 || (p >> (64 - left)) != 0) return ~0ull;
-    return p << left;
+Num& Num::mul(const Num& o) {
+    if (m == 0 || o.m == 0) return set(0);
+    uint64_t p = static_cast<uint64_t>(m) * o.m; // in [2^62, 2^64)
+    int16_t ex = static_cast<int16_t>(e + o.e + 32);
+    if (!(p >> 63)) {
+        p <<= 1;
+        --ex;
+    }
+    return finish(*this, static_cast<uint32_t>(p >> 32), ex);
 }
 
-Ratio make_ratio(uint64_t num, uint64_t den) {
-    // Keep the divisor within 32 bits (relative loss < 2^-31), then scale the dividend so that
-    // the quotient has 32 significant bits: num * 2^s / den in [2^31, 2^33).
-    uint8_t dl = bit_length(den);
-    int16_t s = 0;
-    if (dl > 32) {
-        uint8_t t = static_cast<uint8_t>(dl - 32);
-        den >>= t;
-        s = static_cast<int16_t>(s - t); // value = (num / 2^t) / (den / 2^t): track t on num
-        dl = 32;
+Num& Num::mul(uint32_t v) {
+    return mul(Num(v));
+}
+
+Num& Num::div(const Num& o) {
+    if (m == 0 || o.m == 0) return set(0);
+    int16_t ex = static_cast<int16_t>(e - o.e - 32);
+    if (m < o.m) {
+        // quotient in (1/2, 1): one normalising shift at most
+        uint32_t q = div_hi(m, o.m);
+        if (!(q & 0x80000000ul)) {
+            q <<= 1;
+            --ex;
+        }
+        return finish(*this, q, ex);
     }
-    // We want q = floor(num * 2^(s + k) / den) with k chosen so q has 32 bits.
-    uint8_t nl = bit_length(num);
-    int16_t k = static_cast<int16_t>(32 + dl - nl); // num * 2^k has 32 + dl bits
-    uint64_t n = num;
-    if (k >= 0) {
-        // 32 + dl <= 64 bits: fits.
-        n <<= k;
-    } else {
-        n >>= -k;
+    // m / o.m in [1, 2): 1 + (m - o.m) / o.m, with the fraction's 32 bits shifted in.
+    uint32_t frac = div_hi(m - o.m, o.m);
+    return finish(*this, static_cast<uint32_t>(0x80000000ul | (frac >> 1)),
+                  static_cast<int16_t>(ex + 1));
+}
+
+Num& Num::div(uint32_t v) {
+    return div(Num(v));
+}
+
+Num& Num::add(const Num& o) {
+    if (o.m == 0) return *this;
+    if (m == 0) return *this = o;
+    Num big = *this, small = o;
+    if (big.e < small.e) {
+        big = o;
+        small = *this;
     }
-    uint64_t q = n / den;
-    while (q >= (1ull << 32)) {
-        q >>= 1;
-        --k;
+    uint8_t gap = static_cast<uint8_t>(big.e - small.e);
+    uint32_t sm = gap >= 32 ? 0 : small.m >> gap;
+    uint32_t sum = big.m + sm;
+    if (sum < big.m) {
+        m = static_cast<uint32_t>(0x80000000ul | (sum >> 1));
+        e = static_cast<int8_t>(big.e + 1);
+        return *this;
     }
-    // value = num / den_original = q * 2^-(k) * 2^(s) ... den was divided by 2^t, i.e. the
-    // quotient is 2^t too large: value = q * 2^-(k + t) = q * 2^-(k - s).
-    Ratio r;
-    r.mant = static_cast<uint32_t>(q);
-    int16_t shift = static_cast<int16_t>(k - s);
-    if (shift > 127) shift = 127;
-    if (shift < -127) shift = -127;
-    r.shift = static_cast<int8_t>(shift);
-    return r;
+    return set(sum, big.e);
+}
+
+Num& Num::sqrt() {
+    if (m == 0) return *this;
+    // Make the exponent even: value = m' * 2^e' with m' in [2^30, 2^32).
+    uint32_t v = m;
+    int8_t ex = e;
+    if (ex & 1) {
+        v >>= 1;
+        ++ex;
+    }
+    // sqrt(v * 2^ex) = sqrt(v) * 2^(ex/2); r = sqrt(v) * 2^16 to 16 bits from isqrt32, then one
+    // Newton step r' = (r + v * 2^32 / r) / 2 (2^-31 relative). r is a floor, so v * 2^32 / r
+    // can reach 2^32 just below v = 2^32.
+    uint32_t r = static_cast<uint32_t>(isqrt32(v)) << 16;
+    uint64_t q = v >= r ? (1ull << 32) + div_hi(v - r, r) : div_hi(v, r);
+    uint64_t next = (static_cast<uint64_t>(r) + q) >> 1;
+    if (next >> 32) return set(1, static_cast<int8_t>(ex / 2 + 16));
+    return set(static_cast<uint32_t>(next), static_cast<int8_t>(ex / 2 - 16));
+}
+
+uint32_t Num::u32() const {
+    if (m == 0 || e <= -32) return 0;
+    if (e > 0) return 0xFFFFFFFFul;
+    return m >> static_cast<uint8_t>(-e);
+}
+
+uint32_t Num::of(uint32_t x) const {
+    Num t(x);
+    return t.mul(*this).u32();
+}
+
+int8_t Num::cmp(const Num& o) const {
+    if (m == 0 || o.m == 0) return m == o.m ? 0 : (m == 0 ? -1 : 1);
+    if (e != o.e) return e < o.e ? -1 : 1;
+    if (m != o.m) return m < o.m ? -1 : 1;
+    return 0;
 }
 
 } // namespace ll

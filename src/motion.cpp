@@ -19,15 +19,13 @@ struct Motion {
     bool begun = false;      ///< the planner's first move is in the step generator
     bool enabled = false;    ///< stepper drivers enabled
     uint32_t idle_since = 0; ///< hal::millis() when motion last stopped
-    // A move longer than kMaxLineTicks on one axis is queued in pieces: what is left of it.
-    bool split_pending = false;
-    LineRequest split;
-    uint32_t starvations = 0;
+    uint32_t starvations;
 };
 
-Motion& mo() {
-    static Motion m;
-    return m;
+Motion g_motion;
+
+inline Motion& mo() {
+    return g_motion;
 }
 
 void begin_next(Motion& m) {
@@ -55,37 +53,10 @@ void produce(Motion& m) {
 
 bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) {
-        int64_t d = static_cast<int64_t>(to[a]) - from[a];
-        if (d > static_cast<int64_t>(kMaxLineTicks) || -d > static_cast<int64_t>(kMaxLineTicks)) {
-            return true;
-        }
+        // Positions stay within +-2^30 steps (the G-code layer's range check), so the
+        // difference cannot overflow.
+        if (abs32(to[a] - from[a]) > kMaxLineTicks) return true;
     }
-    return false;
-}
-
-// Queues as much of `req` as one block can take; true when all of it went in.
-bool queue_piece(Motion& m, const LineRequest& req) {
-    const int32_t* from = m.planner.last_target();
-    if (!too_long(from, req.target_steps)) {
-        m.planner.add(req.target_steps, req.target_um, req.feed, req.rapid);
-        return true;
-    }
-    // Halve the remaining travel until it fits: pieces end on exact step targets, and the last
-    // piece ends on the requested target, so nothing accumulates.
-    const int32_t* from_um = m.planner.last_target_um();
-    int32_t mid[kAxes], mid_um[kAxes];
-    int64_t den = 2;
-    for (;;) {
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            int64_t d = static_cast<int64_t>(req.target_steps[a]) - from[a];
-            mid[a] = static_cast<int32_t>(from[a] + d / den);
-            int64_t du = static_cast<int64_t>(req.target_um[a]) - from_um[a];
-            mid_um[a] = static_cast<int32_t>(from_um[a] + du / den);
-        }
-        if (!too_long(from, mid)) break;
-        den *= 2;
-    }
-    m.planner.add(mid, mid_um, req.feed, req.rapid);
     return false;
 }
 
@@ -96,7 +67,7 @@ const int32_t* position_um(Motion& m, const int32_t steps[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) {
         int32_t s = steps[a];
         uint32_t mag = s < 0 ? static_cast<uint32_t>(-(s + 1)) + 1u : static_cast<uint32_t>(s);
-        int32_t v = static_cast<int32_t>(m.machine.um_q8_per_step[a].apply(mag) >> 8);
+        int32_t v = static_cast<int32_t>(m.machine.um_q8_per_step[a].of(mag) >> 8);
         um[a] = s < 0 ? -v : v;
     }
     return um;
@@ -121,24 +92,22 @@ void init() {
     m.gen.set_position(zero);
     m.planner.reset(zero, zero);
     m.begun = false;
-    m.split_pending = false;
     m.enabled = false;
     m.state = State::Idle;
     m.starvations = 0;
 }
 
 bool can_accept() {
-    return !mo().planner.full() && !mo().split_pending;
+    return !mo().planner.full();
 }
 
-void push_line(const LineRequest& req) {
+bool push_line(const LineRequest& req) {
     Motion& m = mo();
-    if (!queue_piece(m, req)) {
-        m.split_pending = true;
-        m.split = req;
-    }
+    if (too_long(m.planner.last_target(), req.target_steps)) return false;
+    m.planner.add(req.target_steps, req.target_um, req.feed, req.rapid);
     if (!m.planner.empty() && m.state == State::Idle) m.state = State::Cycle;
     poll();
+    return true;
 }
 
 uint8_t blocks_free() {
@@ -147,9 +116,6 @@ uint8_t blocks_free() {
 
 void poll() {
     Motion& m = mo();
-    while (m.split_pending && !m.planner.full()) {
-        if (queue_piece(m, m.split)) m.split_pending = false;
-    }
     if (m.state == State::Idle && m.planner.empty() && g_runs.empty() && !g_exec.running) {
         if (m.enabled && g_settings.idle_delay_ms != 255 &&
             hal::millis() - m.idle_since >= g_settings.idle_delay_ms) {
@@ -172,7 +138,7 @@ void poll() {
     if (m.state == State::Holding) {
         if (drained && (m.gen.stopped() || (!m.begun && m.planner.empty()))) m.state = State::Held;
     } else if (m.state == State::Cycle) {
-        if (drained && !m.begun && m.planner.empty() && !m.split_pending) {
+        if (drained && !m.begun && m.planner.empty()) {
             m.state = State::Idle;
             m.idle_since = hal::millis();
         }
@@ -218,7 +184,6 @@ bool abort() {
     m.gen.set_position(here);
     m.planner.reset(here, position_um(m, here));
     m.begun = false;
-    m.split_pending = false;
     m.state = State::Idle;
     m.idle_since = hal::millis();
     return moving;

@@ -6,42 +6,40 @@ namespace ll {
 
 ProfileShape profile_shape(const Profile& p) {
     ProfileShape sh;
-    uint64_t sd = static_cast<uint64_t>(p.s) * p.d;
+    const uint8_t half = static_cast<uint8_t>(p.log_s - 1); // s / 2 = 2^half
+    uint32_t sd = shl_sat(p.d, p.log_s);
     // Start change: accelerate (or decelerate) until A reaches A_cruise.
-    uint64_t change = p.a_entry <= p.a_cruise ? p.a_cruise - p.a_entry : p.a_entry - p.a_cruise;
+    uint32_t change = p.a_entry <= p.a_cruise ? p.a_cruise - p.a_entry : p.a_entry - p.a_cruise;
     // End deceleration: from A_cruise down to A_exit.
-    uint64_t decel = p.a_cruise - p.a_exit;
-    uint64_t x2_change = 2 * change / p.s;
-    uint64_t x2_decel = 2 * p.d - 2 * decel / p.s;
-    if (p.a_entry <= p.a_cruise && change + decel > sd) {
+    uint32_t decel = p.a_cruise - p.a_exit;
+    if (p.a_entry <= p.a_cruise && add_sat(change, decel) > sd) {
         // Too short to reach cruise: the start and end lines meet at the closed-form peak.
         sh.reaches_cruise = false;
-        sh.a_peak = static_cast<uint32_t>((p.a_entry + p.a_exit + sd) / 2);
-        uint64_t x2 = (static_cast<uint64_t>(p.a_exit) + sd - p.a_entry) / p.s; // 2 x_decel
-        sh.x_change = sh.x_decel = static_cast<uint32_t>(x2);
+        sh.a_peak = (add_sat(p.a_entry, p.a_exit) >> 1) + (sd >> 1);
+        // 2 x_decel = (A_exit + s d - A_entry) / s
+        sh.x_change = sh.x_decel = (add_sat(p.a_exit, sd) - p.a_entry) >> p.log_s;
         return sh;
     }
     sh.reaches_cruise = true;
     sh.a_peak = p.a_cruise;
-    sh.x_change = static_cast<uint32_t>(x2_change);
-    sh.x_decel = static_cast<uint32_t>(x2_decel);
+    sh.x_change = change >> half;
+    sh.x_decel = 2 * p.d - (decel >> half);
     return sh;
 }
 
 uint32_t profile_a(const Profile& p, uint32_t x2) {
-    // s is even, so s * x2 / 2 is an integer.
-    uint32_t half_s = p.s >> 1;
-    uint64_t travelled = static_cast<uint64_t>(half_s) * x2;
-    uint64_t start;
+    const uint8_t half = static_cast<uint8_t>(p.log_s - 1); // s * x2 / 2 = x2 << half
+    uint32_t travelled = shl_sat(x2, half);
+    uint32_t start;
     if (p.a_entry <= p.a_cruise) {
-        start = p.a_entry + travelled;
+        start = add_sat(p.a_entry, travelled);
         if (start > p.a_cruise) start = p.a_cruise;
     } else {
         start = travelled >= p.a_entry - p.a_cruise ? p.a_cruise : p.a_entry - travelled;
     }
-    uint64_t to_go2 = 2ull * p.d >= x2 ? 2ull * p.d - x2 : 0;
-    uint64_t end = p.a_exit + static_cast<uint64_t>(half_s) * to_go2;
-    return static_cast<uint32_t>(start < end ? start : end);
+    uint32_t to_go2 = 2 * p.d >= x2 ? 2 * p.d - x2 : 0;
+    uint32_t end = add_sat(p.a_exit, shl_sat(to_go2, half));
+    return start < end ? start : end;
 }
 
 void SqrtTracker::reset(uint32_t a) {

@@ -1,23 +1,21 @@
 #include "lowlevel/stepgen.h"
 
-#include "lowlevel/fixmath.h"
-
 namespace ll {
 namespace {
 
-// 60 s/min * kCpuHz * 256 / 1000: Delta_1 (cycles x 256) = this * len_um / (v * d_1), v in
-// mm/min (seed §3.2 with the reference axis' ticks per mm of path, d_1 / len). Lengths arrive
-// as len_q8 = len_um * 256, hence the extra 2^-8 applied to the ratios below.
-constexpr uint64_t kCruiseNum = 60ull * kCpuHz * 256 / 1000;
-static_assert(kCruiseNum == 245760000ull, "units");
-// floor(kCruiseNum * sqrt(500) / 2): D = 2 * kSqrtCHalf * sqrt(s len_um / (a d_1)), see
-// prepare_profile and docs/motion.md.
+// Delta_1 at cruise, cycles x 256 = 60 s/min * kCpuHz * 256 / 1000 * len_um / (v d_1) with v in
+// mm/min (seed §3.2 with the reference axis' ticks per mm of path, d_1 / len). With lengths in
+// µm x 256 and feeds in mm/min x 1000: 960000000 * len_q8 / (feed * d_1).
+constexpr uint32_t kCruiseNum = 960000000ul;
+static_assert(60ull * kCpuHz * 256 / 1000 * 1000 / 256 == kCruiseNum, "units");
+// floor(60 * kCpuHz * 256 / 1000 * sqrt(500) / 2): D = 2 * kSqrtCHalf * sqrt(s len_um / (a d_1)),
+// the numerator of Delta_1 = D / sqrt(A) (docs/motion.md, "Wait numerator").
 constexpr uint32_t kSqrtCHalf = 2747680330ul;
 // Idle waits used to build periods above 65535 cycles stay below this, so that the final wait
 // (which absorbs the remainder) still fits in 16 bits.
 constexpr uint32_t kIdleChunk = 65000;
 static_assert(kMaxPeriodCycles <= 256ul * kIdleChunk, "idle waits of one event fit a run count");
-// A is kept below this bound (so that s * d and the A values add without overflow).
+// A is kept below this bound (so that A values and s d add without overflow).
 constexpr uint32_t kMaxA = 1ul << 31;
 
 uint32_t max3(uint32_t a, uint32_t b, uint32_t c) {
@@ -64,13 +62,13 @@ void StepGen::build_k_table(uint8_t group) {
     // Average regulated step length of the line's tick path, over the runs of the §8 order
     // (all axes, then all but the shortest, ...): run i has the axes of sorted positions 0..i
     // and lasts dist[i] - dist[i+1] micro steps.
-    uint64_t sum_g = 0;
+    Num sum_g{};
     uint32_t count_g = 0;
     for (uint8_t i = 0; i < m; ++i) {
         uint32_t n = line_.dist[i] - (i + 1 < m ? line_.dist[i + 1] : 0);
         uint32_t len = lengths_->len[k_mask_[(1u << i) - 1] & group];
         if (len != 0) {
-            sum_g += static_cast<uint64_t>(n) * len;
+            sum_g.add(Num(n).mul(len));
             count_g += n;
         }
     }
@@ -81,73 +79,57 @@ void StepGen::build_k_table(uint8_t group) {
     }
     // Runs where no regulated axis steps (seed §3.1: the other groups follow) take the mean
     // regulated step time, so the followers move at their average rate rather than in bursts.
-    uint32_t mean_g = static_cast<uint32_t>(sum_g / count_g);
-    uint64_t stair = 0;
+    uint32_t mean_g = sum_g.div(count_g).u32();
+    Num stair{};
     for (uint8_t i = 0; i < m; ++i) {
         uint32_t n = line_.dist[i] - (i + 1 < m ? line_.dist[i + 1] : 0);
         uint32_t len = lengths_->len[k_mask_[(1u << i) - 1] & group];
-        stair += static_cast<uint64_t>(n) * (len != 0 ? len : mean_g);
+        stair.add(Num(n).mul(len != 0 ? len : mean_g));
     }
     // K_P normalised so that the whole line takes len / V (docs/motion.md, "Feed along the
     // line"): K[P] = L_P * d_1 / stair, Q20.
-    Ratio r = make_ratio(static_cast<uint64_t>(line_.dist[0]) << 20, stair);
-    for (uint8_t sub = 0; sub < sets; ++sub) {
-        uint32_t len = lengths_->len[k_mask_[sub] & group];
-        k_[sub] = r.apply(len != 0 ? len : mean_g);
-    }
+    Num r(line_.dist[0], 20);
+    r.div(stair);
     kmax_ = 0;
     for (uint8_t sub = 0; sub < sets; ++sub) {
+        uint32_t len = lengths_->len[k_mask_[sub] & group];
+        k_[sub] = r.of(len != 0 ? len : mean_g);
         if (k_[sub] > kmax_) kmax_ = k_[sub];
     }
 }
 
 uint32_t StepGen::a_of(uint32_t v2) const {
-    uint64_t a = a_per_v2_.apply64(v2);
-    return a > kMaxA ? kMaxA : static_cast<uint32_t>(a);
+    uint32_t a = a_per_v2_.of(v2);
+    return a > kMaxA ? kMaxA : a;
 }
 
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
     const uint32_t d1 = line_.dist[0];
     // Fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
-    // l = v^2 rho / (2 a) with rho = 1000 d_1 / len_um = 256000 d_1 / len_q8 ticks per mm.
-    Ratio phi = make_ratio(128000ull * d1, static_cast<uint64_t>(spec_.accel) * spec_.len_q8);
-    // D = 60 kCpuHz 256 sqrt(s / (2 a rho)) = 2 kSqrtCHalf sqrt(s len_um / (a d_1)); first at
-    // s = 2, then scaled by sqrt(s / 2) = 2^m.
-    Ratio q = make_ratio(2ull * spec_.len_q8, static_cast<uint64_t>(spec_.accel) * d1);
-    uint64_t mant = q.mant;
-    int16_t sh = static_cast<int16_t>(q.shift + 8);
-    if (sh & 1) {
-        mant <<= 1;
-        ++sh;
-    }
-    uint64_t root = isqrt64(mant << 30); // sqrt(mant) * 2^15
-    uint64_t p = static_cast<uint64_t>(kSqrtCHalf) * root;
-    int16_t shift = static_cast<int16_t>(15 + sh / 2 - 1);
-    uint64_t d2;
-    if (shift >= 0) {
-        d2 = shift >= 64 ? 0 : p >> shift;
-    } else {
-        uint8_t left = static_cast<uint8_t>(-shift);
-        d2 = (left >= 64 || (p >> (64 - left)) != 0) ? ~0ull : p << left;
-    }
-    // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 and D below 2^32.
-    uint64_t l_max = phi.apply64(max3(v_entry2, spec_.v_nominal2, v_exit2)) + remaining_ticks;
+    // l = v^2 rho / (2 a), rho = 1000 d_1 / len_um = 256000 d_1 / len_q8 ticks per mm.
+    Num phi(128000);
+    phi.mul(d1).div(spec_.len_q8).div(spec_.accel);
+    // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)), len_um = len_q8 / 256.
+    Num dn(spec_.len_q8, -7);
+    dn.div(spec_.accel).div(d1).sqrt().mul(kSqrtCHalf).shift(1);
+    // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 and D below 2^32
+    // (D grows as sqrt(s) = 2^m sqrt(2)).
+    uint32_t l_max = add_sat(phi.of(max3(v_entry2, spec_.v_nominal2, v_exit2)), remaining_ticks);
     uint8_t m = 4;
-    while (m > 0 && ((l_max << (2 * m + 1)) > kMaxA || (d2 << m) > 0xFFFFFFFFull)) --m;
-    uint8_t log_s = static_cast<uint8_t>(2 * m + 1);
-    a_per_v2_ = phi;
-    a_per_v2_.shift = static_cast<int8_t>(a_per_v2_.shift - log_s);
-    prof_.s = 1ul << log_s;
+    while (m > 0 && (shl_sat(l_max, static_cast<uint8_t>(2 * m + 1)) > kMaxA ||
+                     Num(dn).shift(static_cast<int8_t>(m)).u32() == 0xFFFFFFFFul)) {
+        --m;
+    }
+    prof_.log_s = static_cast<uint8_t>(2 * m + 1);
+    a_per_v2_ = phi.shift(static_cast<int8_t>(prof_.log_s));
     prof_.d = remaining_ticks;
     prof_.a_entry = a_of(v_entry2);
     prof_.a_cruise = a_of(spec_.v_nominal2);
     prof_.a_exit = a_of(v_exit2);
     if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
-    prof_.d_num = saturate32(d2 << m);
-    // Exact cruise wait of the reference axis along the line: one division per move.
-    Ratio cruise = make_ratio(kCruiseNum * spec_.len_q8, static_cast<uint64_t>(spec_.feed) * d1);
-    cruise.shift = static_cast<int8_t>(cruise.shift + 8);
-    prof_.cruise = cruise.apply(1000);
+    prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
+    // Exact cruise wait of the reference axis along the line: once per move.
+    prof_.cruise = Num(kCruiseNum).mul(spec_.len_q8).div(spec_.feed).div(d1).u32();
     x2_decel_ = profile_shape(prof_).x_decel;
     root_valid_ = false;
 }
@@ -181,13 +163,8 @@ void StepGen::resume(uint32_t v_exit2) {
 }
 
 uint32_t StepGen::speed2() const {
-    if (a_last_ == 0) return 0;
-    Ratio t = make_ratio(a_last_, a_per_v2_.mant);
-    int16_t shift = static_cast<int16_t>(t.shift - a_per_v2_.shift);
-    if (shift > 127) shift = 127;
-    if (shift < -127) shift = -127;
-    t.shift = static_cast<int8_t>(shift);
-    return t.apply(1);
+    if (a_last_ == 0 || a_per_v2_.m == 0) return 0;
+    return Num(a_last_).div(a_per_v2_).u32();
 }
 
 void StepGen::set_position(const int32_t steps[kAxes]) {
@@ -200,47 +177,6 @@ void StepGen::abort() {
     stopped_ = false;
     have_handover_ = false;
     a_last_ = 0;
-}
-
-void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8) {
-    uint32_t period = static_cast<uint32_t>((static_cast<uint64_t>(period_q8) + 128) >> 8);
-    if (period < min_period_) {
-        period = min_period_;
-        ++stats.clamped;
-    }
-    if (period > kMaxPeriodCycles) period = kMaxPeriodCycles;
-    const uint8_t dirs = line_.dirs;
-    uint32_t units = (period * count) >> 10;
-    uint8_t slot_units = units > 255 ? 255 : static_cast<uint8_t>(units);
-    if (period <= 0xFFFF) {
-        slot_time_[q.tail] = slot_units;
-        queued_ = static_cast<uint16_t>(queued_ + slot_units);
-        q.push(Run{steps, dirs, count, static_cast<uint16_t>(period)});
-        ++stats.runs;
-    } else {
-        // Below 245 steps/s: each event is preceded by idle waits (steps == 0) so that every
-        // compare value fits the 16-bit timer without changing its prescaler.
-        uint32_t parts = (period + kIdleChunk - 1) / kIdleChunk;
-        uint16_t each = static_cast<uint16_t>(period / parts);
-        uint16_t last = static_cast<uint16_t>(period - (parts - 1) * each);
-        for (uint8_t i = 0; i < count; ++i) {
-            slot_time_[q.tail] = 255;
-            q.push(Run{0, dirs, static_cast<uint8_t>(parts - 1), each});
-            slot_time_[q.tail] = 63;
-            q.push(Run{steps, dirs, 1, last});
-            queued_ = static_cast<uint16_t>(queued_ + 255 + 63);
-            stats.runs += 2;
-        }
-    }
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        if (steps & (1u << a)) {
-            if (dirs & (1u << a)) {
-                pos_[a] -= count;
-            } else {
-                pos_[a] += count;
-            }
-        }
-    }
 }
 
 uint32_t StepGen::queued_cycles(const RunQueue& q) {
@@ -258,6 +194,52 @@ void StepGen::clear_queue_time() {
     seen_head_ = 0;
 }
 
+void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8) {
+    uint32_t period = period_q8 > 0xFFFFFF7Ful ? 0xFFFFFFul : (period_q8 + 128) >> 8;
+    if (period < min_period_) {
+        period = min_period_;
+#if LL_STATS
+        ++stats.clamped;
+#endif
+    }
+    if (period > kMaxPeriodCycles) period = kMaxPeriodCycles;
+    const uint8_t dirs = line_.dirs;
+    if (period <= 0xFFFF) {
+        uint32_t units = (period * count) >> 10; // < 2^14
+        slot_time_[q.tail] = units > 255 ? 255 : static_cast<uint8_t>(units);
+        queued_ = static_cast<uint16_t>(queued_ + slot_time_[q.tail]);
+        q.push(Run{steps, dirs, count, static_cast<uint16_t>(period)});
+#if LL_STATS
+        ++stats.runs;
+#endif
+    } else {
+        // Below 245 steps/s: each event is preceded by idle waits (steps == 0) so that every
+        // compare value fits the 16-bit timer without changing its prescaler.
+        uint32_t parts = (period + kIdleChunk - 1) / kIdleChunk;
+        uint16_t each = static_cast<uint16_t>(period / parts);
+        uint16_t last = static_cast<uint16_t>(period - (parts - 1) * each);
+        for (uint8_t i = 0; i < count; ++i) {
+            slot_time_[q.tail] = 255;
+            q.push(Run{0, dirs, static_cast<uint8_t>(parts - 1), each});
+            slot_time_[q.tail] = 63;
+            q.push(Run{steps, dirs, 1, last});
+            queued_ = static_cast<uint16_t>(queued_ + 255 + 63);
+#if LL_STATS
+            stats.runs += 2;
+#endif
+        }
+    }
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        if (steps & (1u << a)) {
+            if (dirs & (1u << a)) {
+                pos_[a] -= count;
+            } else {
+                pos_[a] += count;
+            }
+        }
+    }
+}
+
 uint8_t StepGen::fill(RunQueue& q) {
     uint8_t pushed_before = q.used();
     while (active_ && !stopped_) {
@@ -270,12 +252,12 @@ uint8_t StepGen::fill(RunQueue& q) {
         uint32_t x2 = 2 * (cursor_.x1 - origin_) + len; // segment midpoint, half ticks
         uint32_t a = profile_a(prof_, x2);
         if (holding_) {
-            uint64_t dec = static_cast<uint64_t>(prof_.s >> 1) * (x2 - x2_hold_);
+            uint32_t dec = shl_sat(x2 - x2_hold_, static_cast<uint8_t>(prof_.log_s - 1));
             if (dec >= a_hold_) {
                 stopped_ = true; // the speed reaches zero before this segment's midpoint
                 break;
             }
-            uint32_t ah = static_cast<uint32_t>(a_hold_ - dec);
+            uint32_t ah = a_hold_ - dec;
             if (ah < a) a = ah;
         }
         a_last_ = a;
@@ -292,7 +274,9 @@ uint8_t StepGen::fill(RunQueue& q) {
             }
             if (changed) {
                 delta_root_ = prof_.d_num / (root_.r != 0 ? root_.r : 1);
+#if LL_STATS
                 ++stats.divisions;
+#endif
             }
             delta = delta_root_;
             if (a <= prof_.a_cruise && delta < prof_.cruise) delta = prof_.cruise;
@@ -305,19 +289,19 @@ uint8_t StepGen::fill(RunQueue& q) {
         uint8_t n = micro_split(e, line_.m, runs);
         for (uint8_t i = 0; i < n; ++i) {
             uint8_t idx = static_cast<uint8_t>(runs[i].set >> 1);
-            uint32_t period_q8 = saturate32(mul_shr64(delta, k_[idx], 20));
-            emit(q, k_mask_[idx], runs[i].count, period_q8);
+            emit(q, k_mask_[idx], runs[i].count, mul_shr(delta, k_[idx], 20));
         }
+#if LL_STATS
         ++stats.segments;
+#endif
 
         // Next segment: the shortest power of two lasting kSegmentCycles at this speed, and a
         // single tick whenever a period needs idle waits (so a segment never needs more than
         // two queue slots per run).
-        uint64_t tick_q8 = delta;
         uint8_t next = 1;
-        if (mul_shr64(delta, kmax_, 20) <= (0xFFFFull << 8)) {
-            while (next < kMaxSegmentTicks &&
-                   tick_q8 * next < (static_cast<uint64_t>(kSegmentCycles) << 8)) {
+        if (mul_shr(delta, kmax_, 20) <= 0xFFFF00ul) {
+            const uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8;
+            while (next < kMaxSegmentTicks && delta < target / next) {
                 next = static_cast<uint8_t>(next << 1);
             }
         }

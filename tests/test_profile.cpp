@@ -35,13 +35,13 @@ struct SpeedCheck {
 // fixed-point factors (K, D, A rounding).
 SpeedCheck check_line(const lltest::Machine& mach, int32_t ticks, double feed, double accel,
                       double entry, double exit) {
-    ll::StepGen gen;
+    ll::StepGen gen{};
     gen.configure(&mach.lengths, 64);
     ll::MoveSpec spec = mach.move({ticks}, feed, accel, entry, exit);
     auto ev = lltest::run_move(gen, spec);
     const double T = mach.steps_per_mm[0];
     const double a = accel * T, v0 = entry / 60 * T, vc = feed / 60 * T, v1 = exit / 60 * T;
-    const double s = gen.profile().s;
+    const double s = std::ldexp(1.0, gen.profile().log_s);
     SpeedCheck c;
     uint64_t prev = 0;
     for (size_t k = 0; k < ev.size(); ++k) {
@@ -68,7 +68,7 @@ const lltest::Machine kMachine{80, 80, 80, 80};
 
 TEST(ProfileShape, PeakAndDecelerationPointComeFromTheClosedForm) {
     ll::Profile p{};
-    p.s = 2;
+    p.log_s = 1;
     p.d = 1000;
     p.a_entry = 100;
     p.a_cruise = 1000000; // unreachable
@@ -96,7 +96,7 @@ TEST(ProfileShape, PeakAndDecelerationPointComeFromTheClosedForm) {
 
 TEST(ProfileShape, EntryAboveCruiseDeceleratesAtTheStartOnly) {
     ll::Profile p{};
-    p.s = 2;
+    p.log_s = 1;
     p.d = 1000;
     p.a_entry = 1500;
     p.a_cruise = 1000;
@@ -153,7 +153,7 @@ TEST(SpeedProfile, TriangleWhenCruiseIsOutOfReach) {
     // fit, so the peak is v_p^2 = a L: 3098 ticks/s.
     SpeedCheck c = check_line(kMachine, 120, 3000, 1000, 0, 0);
     EXPECT_LE(c.worst_ratio, 1.0);
-    ll::StepGen gen;
+    ll::StepGen gen{};
     gen.configure(&kMachine.lengths, 64);
     auto ev = lltest::run_move(gen, kMachine.move({120}, 3000, 1000));
     double fastest = 0;

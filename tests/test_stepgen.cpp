@@ -88,7 +88,7 @@ TEST(StepGen, CruiseRunsFollowTheSeedWaitTimesAtTheCompensatedSpeed) {
         ll::MoveSpec spec = m.move({delta[0], delta[1], delta[2], delta[3]}, feed, 100000, feed,
                                    feed); // entry = exit = cruise: cruise throughout
         if (spec.len_q8 == 0) continue;
-        ll::StepGen gen;
+        ll::StepGen gen{};
         gen.configure(&m.lengths, 64);
         auto ev = lltest::run_move(gen, spec);
         double veff = effective_speed(m, spec.delta, feed / 60);
@@ -112,7 +112,7 @@ TEST(StepGen, MovesEndExactlyOnTheirTargetWithEveryAxisStepCounted) {
         for (auto& d : delta) d = static_cast<int32_t>(rng() % 20001) - 10000;
         ll::MoveSpec spec =
             m.move({delta[0], delta[1], delta[2], delta[3]}, 500 + rng() % 5000, 50 + rng() % 2000);
-        ll::StepGen gen;
+        ll::StepGen gen{};
         gen.configure(&m.lengths, 64);
         auto ev = lltest::run_move(gen, spec);
         int32_t pos[ll::kAxes] = {};
@@ -133,7 +133,7 @@ TEST(StepGen, DiagonalLinesTakeLengthOverFeedNotTheStaircaseTime) {
     lltest::Machine m{80, 80};
     for (int32_t dy : {0, 3314, 4000, 8000}) {
         ll::MoveSpec spec = m.move({8000, dy}, 1200, 1e6, 1200, 1200);
-        ll::StepGen gen;
+        ll::StepGen gen{};
         gen.configure(&m.lengths, 64);
         uint64_t t = 0;
         lltest::run_move(gen, spec, &t);
@@ -146,7 +146,7 @@ TEST(StepGen, SlowMovesUseIdleWaitsAndKeepTheirTiming) {
     // 5 steps/mm at 6 mm/min: 0.5 step/s, 32 M cycles per step, far above the 16-bit timer.
     lltest::Machine m{5};
     ll::MoveSpec spec = m.move({3}, 6, 1e6, 6, 6);
-    ll::StepGen gen;
+    ll::StepGen gen{};
     gen.configure(&m.lengths, 64);
     ll::RunQueue q;
     q.clear();
@@ -173,7 +173,7 @@ TEST(StepGen, SlowMovesUseIdleWaitsAndKeepTheirTiming) {
 TEST(StepGen, PeriodsNeverGoBelowTheMinimumThePulseNeeds) {
     lltest::Machine m{800};
     ll::MoveSpec spec = m.move({20000}, 30000, 1e5); // 400 kHz asked
-    ll::StepGen gen;
+    ll::StepGen gen{};
     gen.configure(&m.lengths, 200);
     auto ev = lltest::run_move(gen, spec);
     for (const auto& e : ev) ASSERT_GE(e.period, 200);
@@ -183,7 +183,7 @@ TEST(StepGen, PeriodsNeverGoBelowTheMinimumThePulseNeeds) {
 TEST(StepGen, FeedHoldStopsAlongThePathAndResumeFinishesTheMove) {
     lltest::Machine m{80, 80};
     ll::MoveSpec spec = m.move({16000, 8000}, 3000, 500);
-    ll::StepGen gen;
+    ll::StepGen gen{};
     gen.configure(&m.lengths, 64);
     ll::RunQueue q;
     q.clear();

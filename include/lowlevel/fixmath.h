@@ -1,5 +1,15 @@
 // Integer arithmetic helpers for the motion core. No floating point anywhere (seed §6: "on
-// PROSCRIRA les float"): square roots, quotients and scaled ratios are computed on integers.
+// PROSCRIRA les float"): square roots, quotients and scale factors are computed on integers.
+//
+// Where a move is prepared, quantities span many decades (ticks per (mm/min)^2, cycles per
+// sqrt(tick)...), so they are carried as `Num`: a 32-bit integer mantissa with a binary
+// exponent, i.e. a fixed-point value whose binary point is chosen per value. Every operation is
+// an out-of-line integer routine (one 32x32 multiplication, one shift-and-subtract division,
+// one Newton step for a square root), exact to 2^-30 relative; products and quotients are
+// truncated (never rounded up). Values must stay within about 2^-97..2^158: beyond, they
+// saturate or become zero. The methods work in place and chain (`Num(a).mul(b).div(c).u32()`),
+// which keeps each call site to a few instructions on the ATmega328P. The per-segment path of the
+// step generator uses 32-bit integers and shifts only.
 #pragma once
 
 #include <stdint.h>
@@ -8,41 +18,51 @@ namespace ll {
 
 /// floor(sqrt(v)).
 uint16_t isqrt32(uint32_t v);
-/// floor(sqrt(v)).
-uint32_t isqrt64(uint64_t v);
 
 /// floor(num * 2^bits / den), by shift-and-subtract on 32-bit words.
 /// Preconditions: 0 < den < 2^31 and the quotient fits in 32 bits.
 uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits);
 
-/// Number of significant bits of v (0 for v == 0).
-uint8_t bit_length(uint64_t v);
+/// floor(a * b / 2^shift), saturated to 2^32 - 1 (shift <= 63).
+uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift);
 
-/// min(v, 2^32 - 1).
-inline uint32_t saturate32(uint64_t v) {
-    return v > 0xFFFFFFFFull ? 0xFFFFFFFFul : static_cast<uint32_t>(v);
+/// min(x << k, 2^32 - 1).
+uint32_t shl_sat(uint32_t x, uint8_t k);
+/// min(a + b, 2^32 - 1).
+inline uint32_t add_sat(uint32_t a, uint32_t b) {
+    return a + b < a ? 0xFFFFFFFFul : a + b;
 }
 
-/// floor(a * b / 2^shift), shift < 64.
-inline uint64_t mul_shr64(uint32_t a, uint32_t b, uint8_t shift) {
-    return (static_cast<uint64_t>(a) * b) >> shift;
+/// |v| as an unsigned value (also for INT32_MIN).
+inline uint32_t abs32(int32_t v) {
+    return v < 0 ? static_cast<uint32_t>(-(v + 1)) + 1u : static_cast<uint32_t>(v);
 }
 
-/// A positive rational kept as a 32-bit mantissa and a binary exponent: value = mant * 2^-shift,
-/// with mant in [2^31, 2^32) (31 significant bits at least). It carries the per-move conversion
-/// factors of the step generator (ticks per (mm/min)^2, ...), whose range spans many decades,
-/// without a float. Computed where a move is prepared, applied with one multiplication.
-struct Ratio {
-    uint32_t mant;
-    int8_t shift;
+/// value = m * 2^e, m normalised to [2^31, 2^32) (or m == 0 for zero).
+struct Num {
+    uint32_t m;
+    int8_t e;
 
-    /// floor(x * value), saturated to 2^32 - 1.
-    uint32_t apply(uint32_t x) const;
-    /// floor(x * value) on 64 bits, saturated.
-    uint64_t apply64(uint32_t x) const;
+    Num() = default; ///< uninitialised, as a plain integer would be: write `Num x{}` for zero
+    explicit Num(uint32_t v, int8_t exp = 0) { set(v, exp); }
+
+    Num& set(uint32_t v, int8_t exp = 0); ///< v * 2^exp
+    Num& mul(const Num& o);
+    Num& mul(uint32_t v);
+    Num& div(const Num& o); ///< o != 0
+    Num& div(uint32_t v);   ///< v != 0
+    Num& add(const Num& o);
+    Num& sqrt();
+    Num& shift(int8_t k) {
+        if (m) e = static_cast<int8_t>(e + k);
+        return *this;
+    }
+    /// floor(value), saturated to 2^32 - 1.
+    uint32_t u32() const;
+    /// floor(value * x), saturated: applying a prepared factor to an integer.
+    uint32_t of(uint32_t x) const;
+    /// -1, 0, 1 as this <, ==, > o.
+    int8_t cmp(const Num& o) const;
 };
-
-/// num / den with 31 significant bits. Preconditions: num > 0, den > 0.
-Ratio make_ratio(uint64_t num, uint64_t den);
 
 } // namespace ll

@@ -14,7 +14,7 @@ struct PlanBlock {
     uint32_t len_q8;       ///< regulated path length, µm x 256
     uint32_t accel;        ///< acceleration along the path, units/min^2
     uint32_t feed;         ///< nominal speed, units/min x1000
-    uint32_t v_nominal2;   ///< (units/min)^2
+    uint32_t dv2;          ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
     uint32_t v_entry2;     ///< planned entry speed squared
     uint32_t v_max_entry2; ///< junction and nominal limit on the entry speed squared
     uint8_t group;         ///< regulated axes
@@ -56,19 +56,22 @@ class Planner {
     const int32_t* last_target() const { return last_; }
     const int32_t* last_target_um() const { return last_um_; }
 
+    /// Nominal speed squared of a move, (units/min)^2.
+    static uint32_t nominal2(const PlanBlock& b);
+
   private:
     uint8_t index(uint8_t i) const { return static_cast<uint8_t>((head_ + i) % kPlannerSize); }
     void recalculate();
-    uint32_t dv2(const PlanBlock& b) const;
+    uint32_t junction2(const int32_t unit[kAxes]) const;
 
-    const Machine* m_ = nullptr;
+    const Machine* m_;
     PlanBlock ring_[kPlannerSize];
-    uint8_t head_ = 0;
-    uint8_t count_ = 0;
-    int32_t last_[kAxes] = {};
-    int32_t last_um_[kAxes] = {};
-    int32_t prev_unit_[kAxes] = {}; ///< unit vector of the last move, Q29
-    uint8_t prev_group_ = 0;        ///< 0: no previous move (start from rest)
+    uint8_t head_;
+    uint8_t count_;
+    int32_t last_[kAxes];
+    int32_t last_um_[kAxes];
+    int32_t prev_unit_[kAxes]; ///< unit vector of the last move, Q29
+    uint8_t prev_group_;       ///< 0: no previous move (start from rest)
 };
 
 } // namespace ll

@@ -24,7 +24,7 @@ namespace ll {
 
 struct Profile {
     uint32_t d;        ///< reference-axis ticks of the profile
-    uint32_t s;        ///< scale: A grows by s per tick of acceleration
+    uint8_t log_s;     ///< scale s = 2^log_s (log_s odd: s = 2 * 4^m); A grows by s per tick
     uint32_t a_entry;  ///< A at x = 0
     uint32_t a_cruise; ///< A at the nominal (cruise) speed
     uint32_t a_exit;   ///< A at x = d
@@ -43,7 +43,8 @@ ProfileShape profile_shape(const Profile& p);
 
 /// A at half-tick position x2 = 2 x (so that segment midpoints are exact):
 ///   A(x) = min(start(x), A_exit + s (d - x)), start(x) = A_entry +- s x clamped at A_cruise.
-/// The profile must be feasible: A_entry <= A_exit + s d (the planner guarantees it).
+/// The profile must be feasible: A_entry <= A_exit + s d (the planner guarantees it), and
+/// s d < 2^31 (the step generator picks s so).
 uint32_t profile_a(const Profile& p, uint32_t x2);
 
 /// The integer square root that follows A (seed §8.2), with C = R^2 and the next square kept

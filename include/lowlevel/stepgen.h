@@ -100,15 +100,25 @@ class StepGen {
     /// Forgets the current move (soft reset); the position is kept.
     void abort();
 
-    StepGenStats stats{};
+#if LL_STATS
+    StepGenStats stats;
+#endif
 
     // Exposed for the tests: the prepared move.
-    const LineGeometry& line() const { return line_; }
-    const Profile& profile() const { return prof_; }
+    const LineGeometry& line() const {
+        return line_;
+    }
+    const Profile& profile() const {
+        return prof_;
+    }
     /// K table: normalised wait-time factor of each axis set containing the reference axis,
     /// indexed by (sorted-position set >> 1), Q16. Delta_P = K[P] * Delta_1 >> 16.
-    uint32_t k(uint8_t index) const { return k_[index]; }
-    uint8_t segment_ticks() const { return seg_len_; }
+    uint32_t k(uint8_t index) const {
+        return k_[index];
+    }
+    uint8_t segment_ticks() const {
+        return seg_len_;
+    }
 
   private:
     void prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks);
@@ -116,42 +126,42 @@ class StepGen {
     uint32_t a_of(uint32_t v2) const;
     void emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8);
 
-    const StepLengths* lengths_ = nullptr;
-    uint16_t min_period_ = 160;
-    bool active_ = false;
-    bool holding_ = false;
-    bool stopped_ = false;
-    bool have_handover_ = false;
-    uint8_t seg_len_ = 1;
-    uint8_t decelerating_ = 0;
+    const StepLengths* lengths_;
+    uint16_t min_period_;
+    bool active_;
+    bool holding_;
+    bool stopped_;
+    bool have_handover_;
+    uint8_t seg_len_;
+    uint8_t decelerating_;
 
-    MoveSpec spec_{};
-    LineGeometry line_{};
-    LineCursor cursor_{};
-    Profile prof_{};
-    Ratio a_per_v2_{};    ///< A per (mm/min)^2 at the profile's scale
-    uint32_t origin_ = 0; ///< reference tick where the profile starts (moves after a resume)
-    uint32_t x2_decel_ = 0;
-    SqrtTracker root_{};
-    bool root_valid_ = false;
-    uint32_t delta_q8_ = 0;   ///< Delta_1 of the last segment, cycles x 256
-    uint32_t a_last_ = 0;     ///< A of the last segment
-    uint32_t delta_root_ = 0; ///< d_num / R for the current R
-    uint32_t kmax_ = 0;       ///< largest K of the move
+    MoveSpec spec_;
+    LineGeometry line_;
+    LineCursor cursor_;
+    Profile prof_;
+    Num a_per_v2_;    ///< A per (mm/min)^2 at the profile's scale
+    uint32_t origin_; ///< reference tick where the profile starts (moves after a resume)
+    uint32_t x2_decel_;
+    SqrtTracker root_;
+    bool root_valid_;
+    uint32_t delta_q8_;   ///< Delta_1 of the last segment, cycles x 256
+    uint32_t a_last_;     ///< A of the last segment
+    uint32_t delta_root_; ///< d_num / R for the current R
+    uint32_t kmax_;       ///< largest K of the move
     // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
-    uint32_t a_hold_ = 0;
-    uint32_t x2_hold_ = 0;
-    uint32_t handover_v2_ = 0;
+    uint32_t a_hold_;
+    uint32_t x2_hold_;
+    uint32_t handover_v2_;
 
     // Duration of each queued run in 1024-cycle units (saturated), by queue slot, and their
     // sum: lets fill() keep the horizon without any help from the interrupt.
-    uint8_t slot_time_[kRunQueueSize] = {};
-    uint16_t queued_ = 0;
-    uint8_t seen_head_ = 0;
+    uint8_t slot_time_[kRunQueueSize];
+    uint16_t queued_;
+    uint8_t seen_head_;
 
     uint32_t k_[1u << (kAxes - 1)];
     uint8_t k_mask_[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
-    int32_t pos_[kAxes] = {};
+    int32_t pos_[kAxes];
 };
 
 } // namespace ll
