@@ -49,31 +49,45 @@ enum AxisCommand : uint8_t { kAxisNone, kAxisNonModal, kAxisMotion };
 
 enum Flow : uint8_t { kFlowRunning, kFlowPause, kFlowEnd };
 
-// Value words kept as Decimal until the units of the block are known. I J K P Q R are stored
-// for the curve commands to come (G2/G3: I J K R P, G2.1/G3.1 and G5: I J P Q).
-enum Slot : uint8_t { kSlotF, kSlotI, kSlotJ, kSlotK, kSlotP, kSlotQ, kSlotR, kSlotAxis };
-constexpr uint8_t kSlots = kSlotAxis + kAxes;
-
-// What each letter A..Z is, besides G and M: a Decimal slot or one of these.
-enum : uint8_t { kLetterN = 0xF0, kLetterL, kLetterS, kLetterT, kLetterNone = 0xFF };
-constexpr uint8_t axis_slot(uint8_t a) {
-    return a < kAxes ? static_cast<uint8_t>(kSlotAxis + a) : static_cast<uint8_t>(kLetterNone);
+// Value letters other than the axes, numbered so that their bit in Block::words is their number.
+// F I J K P Q R keep their Decimal until the units of the block are known (the curves to come
+// use I J K R and P Q: G2/G3 I J K R P, G2.1/G3.1 and G5 I J P Q).
+enum Word : uint8_t {
+    kWordF,
+    kWordI,
+    kWordJ,
+    kWordK,
+    kWordP,
+    kWordQ,
+    kWordR,
+    kWordN,
+    kWordL,
+    kWordS,
+    kWordT
+};
+constexpr uint8_t kDecimalWords = kWordR + 1; // Block::v[0..6]; the axes follow
+constexpr uint8_t kWordAxis = 16;             // kLetterInfo of axis a: kWordAxis + a
+constexpr uint8_t kLetterNone = 0xFF;
+constexpr uint16_t bit(Word w) {
+    return static_cast<uint16_t>(1u << w);
 }
+
+constexpr uint8_t axis_letter(uint8_t a) {
+    return a < kAxes ? static_cast<uint8_t>(kWordAxis + a) : kLetterNone;
+}
+// What each letter A..Z is, besides G and M.
 const uint8_t kLetterInfo[26] LL_PROGMEM = {
-    axis_slot(3), axis_slot(4), axis_slot(5),              // A B C
-    kLetterNone,  kLetterNone,  kSlotF,       kLetterNone, // D E F G
-    kLetterNone,  kSlotI,       kSlotJ,       kSlotK,      // H I J K
-    kLetterL,     kLetterNone,  kLetterN,     kLetterNone, // L M N O
-    kSlotP,       kSlotQ,       kSlotR,       kLetterS,    // P Q R S
-    kLetterT,     kLetterNone,  kLetterNone,  kLetterNone, // T U V W
-    axis_slot(0), axis_slot(1), axis_slot(2),              // X Y Z
+    axis_letter(3), axis_letter(4), axis_letter(5), // A B C
+    kLetterNone,    kLetterNone,    kWordF,         // D E F
+    kLetterNone,    kLetterNone,    kWordI,         // G H I
+    kWordJ,         kWordK,         kWordL,         // J K L
+    kLetterNone,    kWordN,         kLetterNone,    // M N O
+    kWordP,         kWordQ,         kWordR,         // P Q R
+    kWordS,         kWordT,         kLetterNone,    // S T U
+    kLetterNone,    kLetterNone,    axis_letter(0), // V W X
+    axis_letter(1), axis_letter(2),                 // Y Z
 };
 
-constexpr uint32_t letter_bit(char c) {
-    return 1ul << (c - 'A');
-}
-constexpr uint32_t kAxisLetterBits = letter_bit('X') | letter_bit('Y') | letter_bit('Z') |
-                                     letter_bit('A') | letter_bit('B') | letter_bit('C');
 constexpr uint32_t kNoLineNumber = 0xFFFFFFFFu;
 
 struct Block {
@@ -85,14 +99,33 @@ struct Block {
     uint8_t l;          // L, 0xFF when not an integer 0..254
     uint8_t tool;
     uint16_t groups; // modal groups commanded in this block
-    uint32_t words;  // letters present, bit (letter - 'A')
+    uint16_t words;  // value letters present, bit(Word)
     uint32_t n;
     uint32_t s;
-    num::Decimal v[kSlots];
+    num::Decimal v[kDecimalWords + kAxes]; // F I J K P Q R, then the axes
 };
+
+// The block being checked and what it computes, kept static: a stack frame this large costs
+// the AVR an address computation on every access (displacements stop at 63 bytes), and the
+// static size is visible to the RAM budget.
+struct Work {
+    Block b;
+    int32_t values[kAxes];  // axis words of the block, um
+    int32_t offsets[kAxes]; // new G54 (G10) or G92 offsets, um
+    motion::LineRequest req;
+};
+Work w;
+
+// Steps per um of each axis as whole + k / 2^32 (see um_to_steps).
+struct Scale {
+    uint32_t k;     // floor(frac * 2^32 / 10^6), frac = steps_per_unit mod 10^6
+    uint16_t whole; // steps_per_unit / 10^6
+};
+Scale g_scale[kAxes];
 
 // The first decimal of a command number (G92.1 -> 1), or 0xFF with a finer fraction (G1.05).
 uint8_t tenths(const num::Decimal& d) {
+    if (d.frac == 0 && d.sub == 0) return 0; // the usual case: G1, G90
     if (d.sub != 0 || (d.flags & num::Decimal::kInexact) != 0) return 0xFF;
     for (uint8_t t = 0; t < 10; ++t) {
         if (d.frac == t * 100u) return t;
@@ -234,31 +267,38 @@ uint8_t import_m(Block& b, const num::Decimal& d) {
 uint8_t import_value(Block& b, char letter, const num::Decimal& d) {
     uint8_t info = flash_read_byte(&kLetterInfo[letter - 'A']);
     if (info == kLetterNone) return kUnsupportedCommand;
-    uint32_t bit = letter_bit(letter);
-    if (b.words & bit) return kWordRepeated;
-    if (d.negative() && (info == kSlotF || info == kSlotP || info == kLetterN || info == kLetterS ||
-                         info == kLetterT))
-        return kNegativeValue;
-    b.words |= bit;
+    if (info >= kWordAxis) {
+        uint8_t a = static_cast<uint8_t>(info - kWordAxis);
+        uint8_t abit = static_cast<uint8_t>(1u << a);
+        if (b.axis_words & abit) return kWordRepeated;
+        b.axis_words |= abit;
+        b.v[kDecimalWords + a] = d;
+        return kOk;
+    }
+    Word word = static_cast<Word>(info);
+    if (b.words & bit(word)) return kWordRepeated;
+    constexpr uint16_t kNotNegative =
+        bit(kWordF) | bit(kWordP) | bit(kWordN) | bit(kWordS) | bit(kWordT);
+    if (d.negative() && (bit(word) & kNotNegative)) return kNegativeValue;
+    b.words |= bit(word);
     uint32_t v;
-    switch (info) {
-        case kLetterN:
+    switch (word) {
+        case kWordN:
             b.n = num::to_uint(d, 10000000u, v) ? v : kNoLineNumber;
             break;
-        case kLetterL:
+        case kWordL:
             b.l = num::to_uint(d, 254u, v) ? static_cast<uint8_t>(v) : 0xFF;
             break;
-        case kLetterT:
+        case kWordT:
             if (!d.integral()) return kCommandValueNotInteger;
             if (d.ipart > 255) return kMaxValueExceeded;
             b.tool = static_cast<uint8_t>(d.ipart);
             break;
-        case kLetterS:
+        case kWordS:
             b.s = d.ipart + (d.frac >= 500 ? 1u : 0u);
             break;
         default:
-            b.v[info] = d;
-            if (info >= kSlotAxis) b.axis_words |= static_cast<uint8_t>(1u << (info - kSlotAxis));
+            b.v[word] = d;
             break;
     }
     return kOk;
@@ -282,8 +322,35 @@ bool sub(int32_t a, int32_t b, int32_t& out) {
 
 } // namespace
 
+// round(|um| * s / 10^6) without a division: q = floor(|um| * k / 2^32) is the floor of
+// |um| * frac / 10^6 or one less (k is short of the exact ratio by less than 1 and |um| < 2^31);
+// the remainder |um| * frac - q * 10^6 is then exact in 32-bit wrap-around arithmetic (it is
+// below 2 * 10^6) and settles both the missing unit and the rounding. The whole part of the
+// ratio (1000 steps/mm and more) is one multiplication.
 bool um_to_steps(uint8_t axis, int32_t um, int32_t& steps) {
-    return num::mul_div_round(um, g_settings.axis[axis].steps_per_unit, 1000000u, steps);
+    const Scale& sc = g_scale[axis];
+    bool negative = um < 0;
+    uint32_t m = negative ? 0u - static_cast<uint32_t>(um) : static_cast<uint32_t>(um);
+    uint32_t frac = g_settings.axis[axis].steps_per_unit;
+    if (sc.whole != 0) frac -= sc.whole * 1000000u;
+    uint32_t q, lo;
+    num::mul64(m, sc.k, q, lo);
+    uint32_t r = m * frac - q * 1000000u;
+    if (r >= 1000000u) {
+        r -= 1000000u;
+        ++q;
+    }
+    if (r >= 500000u) ++q; // half away from zero, on the magnitude
+    if (sc.whole != 0) {
+        uint32_t whole;
+        if (__builtin_mul_overflow(m, static_cast<uint32_t>(sc.whole), &whole) ||
+            __builtin_add_overflow(q, whole, &q)) {
+            return false;
+        }
+    }
+    if (q > 0x7FFFFFFFu) return false;
+    steps = negative ? -static_cast<int32_t>(q) : static_cast<int32_t>(q);
+    return true;
 }
 
 uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
@@ -292,7 +359,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     outcome.dwell_ms = 0;
 
     // ---- Stage 1: a block that starts from the current modes.
-    Block b;
+    Block& b = w.b;
     b.modal = st.modal;
     b.non_modal = kNoNonModal;
     b.axis_command = kAxisNone;
@@ -322,50 +389,50 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     // ---- Stage 3: check the block as a whole and compute everything it will change.
     // [0] Axis words without a command that uses them: the current motion mode does.
     if (b.axis_words != 0 && b.axis_command == kAxisNone) b.axis_command = kAxisMotion;
-    if ((b.words & letter_bit('N')) && b.n == kNoLineNumber) return kInvalidLineNumber;
+    if ((b.words & bit(kWordN)) && b.n == kNoLineNumber) return kInvalidLineNumber;
 
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
     uint32_t feed = st.feed;
-    if (b.words & letter_bit('F')) {
+    if (b.words & bit(kWordF)) {
         int32_t f;
-        if (!length(b, kSlotF, f)) return kBadNumberFormat;
+        if (!length(b, kWordF, f)) return kBadNumberFormat;
         feed = static_cast<uint32_t>(f);
     }
 
     // [10] Dwell: P seconds.
     int32_t dwell_ms = 0;
     if (b.non_modal == kDwellCmd) {
-        if (!(b.words & letter_bit('P'))) return kValueWordMissing;
-        if (!num::to_milli(b.v[kSlotP], dwell_ms)) return kBadNumberFormat;
-        b.words &= ~letter_bit('P');
+        if (!(b.words & bit(kWordP))) return kValueWordMissing;
+        if (!num::to_milli(b.v[kWordP], dwell_ms)) return kBadNumberFormat;
+        b.words &= static_cast<uint16_t>(~bit(kWordP));
     }
 
     // [15] Coordinate system: G54 only.
     if (b.modal.coord != 0) return kUnsupportedCoordSys;
 
     // [19] Non-modal commands that use axis words, and the motion target.
-    int32_t values[kAxes]; // axis words of the block in um (machine units)
+    int32_t* values = w.values;
     for (uint8_t a = 0; a < kAxes; ++a) {
         values[a] = 0;
         if (has_axis(b.axis_words, a)) {
-            if (!length(b, static_cast<uint8_t>(kSlotAxis + a), values[a])) {
+            if (!length(b, static_cast<uint8_t>(kDecimalWords + a), values[a])) {
                 return kBadNumberFormat;
             }
         }
     }
-    int32_t offsets[kAxes]; // new G54 (G10) or G92 offsets
-    motion::LineRequest req;
+    int32_t* offsets = w.offsets;
+    motion::LineRequest& req = w.req;
     switch (b.non_modal) {
         case kSetCoordData: { // G10 L2 / L20 P0|P1: G54
             if (b.axis_words == 0) return kNoAxisWords;
-            if (!(b.words & letter_bit('P')) || !(b.words & letter_bit('L'))) {
+            if (!(b.words & bit(kWordP)) || !(b.words & bit(kWordL))) {
                 return kValueWordMissing;
             }
             uint32_t p;
-            if (!num::to_uint(b.v[kSlotP], 255u, p) || p > 1) return kUnsupportedCoordSys;
+            if (!num::to_uint(b.v[kWordP], 255u, p) || p > 1) return kUnsupportedCoordSys;
             if (b.l != 2 && b.l != 20) return kUnsupportedCommand;
-            if (b.l == 2 && (b.words & letter_bit('R'))) return kUnsupportedCommand;
-            b.words &= ~(letter_bit('L') | letter_bit('P'));
+            if (b.l == 2 && (b.words & bit(kWordR))) return kUnsupportedCommand;
+            b.words &= static_cast<uint16_t>(~(bit(kWordL) | bit(kWordP)));
             for (uint8_t a = 0; a < kAxes; ++a) {
                 offsets[a] = st.g54[a];
                 if (!(has_axis(b.axis_words, a))) continue;
@@ -426,9 +493,9 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     }
 
     // [0] Every word must have been used.
-    uint32_t unused =
-        b.words & ~(letter_bit('N') | letter_bit('F') | letter_bit('S') | letter_bit('T'));
-    if (b.axis_command != kAxisNone) unused &= ~kAxisLetterBits;
+    // (Axis words always have a user by now: the motion mode takes them, or G80 refused them.)
+    uint16_t unused =
+        b.words & static_cast<uint16_t>(~(bit(kWordN) | bit(kWordF) | bit(kWordS) | bit(kWordT)));
     if (unused != 0) return kUnusedWords;
 
     // ---- The block is valid. Conditions to wait for, still without any side effect.
@@ -507,6 +574,7 @@ bool reset() {
     st.line_number = 0;
     for (uint8_t a = 0; a < kAxes; ++a) st.g92[a] = 0;
     bool ok = settings::load_coord(st.g54);
+    settings_changed(); // the step scales
     sync_position();
     st.wco_changed = 1;
     return ok;
@@ -524,6 +592,11 @@ void sync_position() {
 
 void settings_changed() {
     for (uint8_t a = 0; a < kAxes; ++a) {
+        uint32_t s = g_settings.axis[a].steps_per_unit;
+        uint16_t whole = static_cast<uint16_t>(s / 1000000u);
+        uint32_t rem;
+        g_scale[a].whole = whole;
+        g_scale[a].k = num::div64(s - whole * 1000000u, 0, 1000000u, rem);
         um_to_steps(a, g_state.position[a], g_state.position_steps[a]);
     }
 }

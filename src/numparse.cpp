@@ -41,8 +41,8 @@ bool parse(const char* s, uint8_t& pos, Decimal& out) {
         if (d > 9) break;
         any_digit = true;
         if (!point) {
-            if (out.ipart > kMaxIpart / 10) return false; // a 10th significant digit
-            out.ipart = out.ipart * 10 + d;
+            if (out.ipart > kMaxIpart / 10) return false;        // a 10th significant digit
+            out.ipart = (out.ipart << 3) + (out.ipart << 1) + d; // x10 without a call
         } else {
             if (decimals < 3) {
                 out.frac = static_cast<uint16_t>(out.frac * 10 + d);
@@ -86,42 +86,53 @@ bool to_uint(const Decimal& d, uint32_t max, uint32_t& out) {
     return true;
 }
 
-bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out) {
-    bool negative = a < 0;
-    uint32_t m = negative ? 0u - static_cast<uint32_t>(a) : static_cast<uint32_t>(a);
-    // 64-bit product hi:lo from four 16x16 products (the chip has an 8x8 multiplier and no
-    // 64-bit shift worth calling).
-    uint16_t ml = static_cast<uint16_t>(m), mh = static_cast<uint16_t>(m >> 16);
+// 16x16 -> 32 bits. Kept out of line so that the compiler sees 16-bit operands and calls the
+// chip's short widening routine (__umulhisi3) instead of a full 32x32 multiplication.
+__attribute__((noinline)) uint32_t mul16(uint16_t a, uint16_t b) {
+    return static_cast<uint32_t>(a) * b;
+}
+
+void mul64(uint32_t a, uint32_t b, uint32_t& hi, uint32_t& lo) {
+    uint16_t al = static_cast<uint16_t>(a), ah = static_cast<uint16_t>(a >> 16);
     uint16_t bl = static_cast<uint16_t>(b), bh = static_cast<uint16_t>(b >> 16);
-    uint32_t lo = static_cast<uint32_t>(ml) * bl;
-    uint32_t mid1 = static_cast<uint32_t>(ml) * bh;
-    uint32_t mid2 = static_cast<uint32_t>(mh) * bl;
-    uint32_t hi = static_cast<uint32_t>(mh) * bh;
+    uint32_t l = mul16(al, bl);
+    uint32_t mid1 = mul16(al, bh);
+    uint32_t mid2 = mul16(ah, bl);
+    uint32_t h = mul16(ah, bh);
     uint32_t mid = mid1 + mid2;
-    if (mid < mid1) hi += 0x10000u; // carry out of the middle sum is worth 2^48
-    uint32_t t = lo + (mid << 16);
-    if (t < lo) ++hi;
+    if (mid < mid1) h += 0x10000u; // the carry out of the middle sum is worth 2^48
+    uint32_t t = l + (mid << 16);
+    if (t < l) ++h;
     lo = t;
-    hi += mid >> 16;
-    // + c/2: half away from zero on the magnitude.
-    t = lo + (c >> 1);
-    if (t < lo) ++hi;
-    lo = t;
-    if (hi >= c) {
-        out = negative ? -static_cast<int32_t>(kInt32Max) - 1 : static_cast<int32_t>(kInt32Max);
-        return false;
-    }
-    // Restoring division of hi:lo by c; rem < c < 2^31, so rem << 1 never overflows.
-    uint32_t rem = hi;
+    hi = h + (mid >> 16);
+}
+
+uint32_t div64(uint32_t hi, uint32_t lo, uint32_t c, uint32_t& rem) {
+    // Restoring division, one quotient bit per turn; r < c < 2^31, so r << 1 never overflows.
+    uint32_t r = hi;
     for (uint8_t k = 0; k < 32; ++k) {
-        rem = (rem << 1) | (lo >> 31);
+        r = (r << 1) | (lo >> 31);
         lo <<= 1;
-        if (rem >= c) {
-            rem -= c;
+        if (r >= c) {
+            r -= c;
             lo |= 1u;
         }
     }
-    if (!finish(negative, lo, out)) {
+    rem = r;
+    return lo;
+}
+
+bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out) {
+    bool negative = a < 0;
+    uint32_t m = negative ? 0u - static_cast<uint32_t>(a) : static_cast<uint32_t>(a);
+    uint32_t hi, lo;
+    mul64(m, b, hi, lo);
+    // + c/2: half away from zero on the magnitude.
+    uint32_t t = lo + (c >> 1);
+    if (t < lo) ++hi;
+    lo = t;
+    uint32_t rem;
+    if (hi >= c || !finish(negative, div64(hi, lo, c, rem), out)) {
         out = negative ? -static_cast<int32_t>(kInt32Max) - 1 : static_cast<int32_t>(kInt32Max);
         return false;
     }

@@ -6,6 +6,7 @@
 #include "host_hal.h"
 #include "lowlevel/gcode.h"
 #include "lowlevel/motion.h"
+#include "lowlevel/numparse.h"
 #include "lowlevel/settings.h"
 #include "lowlevel/status.h"
 
@@ -365,4 +366,24 @@ TEST_F(GCode, ARejectedLineChangesNoModalState) {
     ok("X2"); // the next valid line runs as if the bad one never came
     EXPECT_EQ(gcode::g_state.position[0], 2000);
     EXPECT_EQ(gcode::g_state.feed, 200000u);
+}
+
+TEST_F(GCode, StepScalingMatchesTheExactRoundedQuotient) {
+    uint32_t scales[] = {1,      999,     1000,    80000,   250000,   3333,
+                         999999, 1000000, 1000001, 3200000, 51200000, 2147483647};
+    uint32_t seed = 12345;
+    for (uint32_t s : scales) {
+        set_steps_per_mm(0, s);
+        for (int i = 0; i < 20000; ++i) {
+            seed = seed * 1664525u + 1013904223u;
+            int32_t um = static_cast<int32_t>(seed) >> (seed % 31);
+            int32_t expect = 0, got = 0;
+            bool fits = ll::num::mul_div_round(um, s, 1000000u, expect);
+            bool ok = gcode::um_to_steps(0, um, got);
+            ASSERT_EQ(ok, fits && expect != INT32_MIN) << s << " " << um;
+            if (ok) {
+                ASSERT_EQ(got, expect) << s << " " << um;
+            }
+        }
+    }
 }

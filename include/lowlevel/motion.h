@@ -28,10 +28,10 @@ uint8_t blocks_free();
 void poll();
 
 enum class State : uint8_t {
-    Idle,     ///< nothing queued, nothing moving
-    Cycle,    ///< moving or about to move
-    Holding,  ///< feed hold requested, decelerating (GRBL "Hold:1")
-    Held,     ///< feed hold complete, motion stopped and resumable (GRBL "Hold:0")
+    Idle,    ///< nothing queued, nothing moving
+    Cycle,   ///< moving or about to move
+    Holding, ///< feed hold requested, decelerating (GRBL "Hold:1")
+    Held,    ///< feed hold complete, motion stopped and resumable (GRBL "Hold:0")
 };
 State state();
 

@@ -49,5 +49,10 @@ bool to_uint(const Decimal& d, uint32_t max, uint32_t& out);
 /// saturates `out`) when the result does not fit in an int32.
 bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out);
 
+/// The 64-bit product a * b as two halves.
+void mul64(uint32_t a, uint32_t b, uint32_t& hi, uint32_t& lo);
+/// (hi:lo) / c and its remainder. Preconditions: 0 < c < 2^31 and hi < c (the quotient fits).
+uint32_t div64(uint32_t hi, uint32_t lo, uint32_t c, uint32_t& rem);
+
 } // namespace num
 } // namespace ll

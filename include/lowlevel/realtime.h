@@ -23,11 +23,20 @@ extern volatile uint8_t g_pending;
 /// may send them at any time and they must not corrupt a line.
 inline bool filter(uint8_t byte) {
     switch (byte) {
-        case '?': g_pending |= kStatusReport; return true;
-        case '!': g_pending |= kFeedHold; return true;
-        case '~': g_pending |= kCycleStart; return true;
-        case 0x18: g_pending |= kReset; return true;
-        default: break;
+        case '?':
+            g_pending |= kStatusReport;
+            return true;
+        case '!':
+            g_pending |= kFeedHold;
+            return true;
+        case '~':
+            g_pending |= kCycleStart;
+            return true;
+        case 0x18:
+            g_pending |= kReset;
+            return true;
+        default:
+            break;
     }
     if (byte < 0x84) return false;
     return byte <= 0x87 || (byte >= 0x90 && byte <= 0x9D) || byte == 0xA0 || byte == 0xA1;
