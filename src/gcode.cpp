@@ -342,11 +342,9 @@ bool um_to_steps(uint8_t axis, int32_t um, int32_t& steps) {
     }
     if (r >= 500000u) ++q; // half away from zero, on the magnitude
     if (sc.whole != 0) {
-        uint32_t whole;
-        if (__builtin_mul_overflow(m, static_cast<uint32_t>(sc.whole), &whole) ||
-            __builtin_add_overflow(q, whole, &q)) {
-            return false;
-        }
+        uint32_t hi, whole;
+        num::mul64(m, sc.whole, hi, whole);
+        if (hi != 0 || __builtin_add_overflow(q, whole, &q)) return false;
     }
     if (q > 0x7FFFFFFFu) return false;
     steps = negative ? -static_cast<int32_t>(q) : static_cast<int32_t>(q);
