@@ -600,7 +600,10 @@ void settings_changed() {
 }
 
 void work_offset(int32_t (&um)[kAxes]) {
-    for (uint8_t a = 0; a < kAxes; ++a) um[a] = g_state.g54[a] + g_state.g92[a];
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        um[a] = static_cast<int32_t>(static_cast<uint32_t>(g_state.g54[a]) +
+                                     static_cast<uint32_t>(g_state.g92[a]));
+    }
 }
 
 void report_modes() {

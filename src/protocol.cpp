@@ -127,7 +127,10 @@ void report_status() {
     bool mpos = (g_settings.status_mask & 1u) != 0;
     for (uint8_t a = 0; a < kAxes; ++a) {
         num::mul_div_round(steps[a], 1000000u, g_settings.axis[a].steps_per_unit, pos[a]);
-        if (!mpos) pos[a] -= wco[a];
+        // Wrapping subtraction: a display value, never UB even for absurd offsets.
+        if (!mpos)
+            pos[a] =
+                static_cast<int32_t>(static_cast<uint32_t>(pos[a]) - static_cast<uint32_t>(wco[a]));
     }
     out::str(mpos ? LL_PSTR("|MPos:") : LL_PSTR("|WPos:"));
     out::coords(pos);
