@@ -4,6 +4,7 @@
 #pragma once
 
 #include "lowlevel/config.h"
+#include "lowlevel/numparse.h"
 
 namespace ll {
 
@@ -31,5 +32,36 @@ struct Settings {
 };
 
 extern Settings g_settings;
+
+// EEPROM layout (docs/protocol.md): byte 0 holds kEepromVersion, then the Settings image of this
+// build and a 16-bit checksum; from kEepromCoordAddr the G54 offsets (kAxes x int32 um) and their
+// checksum. A version byte that differs (blank chip 0xFF, GRBL's own layout 10, another axis
+// count) or a checksum that fails means "restore the defaults".
+namespace settings {
+
+constexpr uint8_t kEepromVersion = 0xA0 + kAxes; ///< layout 1 of Low Level, for kAxes axes
+constexpr uint16_t kEepromSettingsAddr = 1;
+constexpr uint16_t kEepromCoordAddr = 256;
+
+/// Loads g_settings from EEPROM. When the record is blank or corrupt, restores the defaults,
+/// writes them (settings and G54 offsets) and returns false; the caller reports it.
+bool load();
+/// GRBL 1.1h's generic defaults ($0=10 us, $1=25 ms, 250 steps/mm, 500 mm/min, 10 mm/s^2,
+/// 200 mm travel), $10=3 and axis groups X,Y,Z -> 0, others -> 1. Writes them to EEPROM.
+void restore_defaults();
+/// `$number=value`: validates, stores in g_settings and EEPROM. Returns status::kOk or the GRBL
+/// error (negative or zero where a positive value is needed: 4; $0 < 3: 6; unknown number,
+/// out of range or a fraction where an integer is needed: 3). The caller then tells the motion
+/// side (motion::settings_changed()).
+uint8_t store(uint8_t number, const num::Decimal& value);
+/// `$$`: every setting as `$N=value` lines, GRBL 1.1 format (integers for masks and booleans,
+/// 3 decimals for values in units).
+void report();
+
+/// G54 work offsets, um. False (and zeros, rewritten) when the record is blank or corrupt.
+bool load_coord(int32_t (&um)[kAxes]);
+void save_coord(const int32_t (&um)[kAxes]);
+
+} // namespace settings
 
 } // namespace ll

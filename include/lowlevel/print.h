@@ -1,0 +1,36 @@
+// Formatting of everything the firmware sends: GRBL's responses, reports and fixed-point values,
+// straight to hal::serial_put (no buffer, no printf, no division: digits come from subtracting
+// powers of ten).
+#pragma once
+
+#include <stdint.h>
+
+#include "lowlevel/config.h"
+#include "lowlevel/pgm.h"
+
+namespace ll {
+namespace out {
+
+void ch(char c);
+/// A string kept in flash (LL_PSTR).
+void str(const FlashChar* s);
+/// "\r\n", GRBL's line end.
+void eol();
+/// An unsigned integer in decimal.
+void u32(uint32_t v);
+/// A fixed-point value `v` scaled by 10^decimals, printed with exactly `decimals` decimals:
+/// fixed(-1500, 3) prints "-1.500", fixed(7, 3) prints "0.007". decimals <= 9.
+void fixed(int32_t v, uint8_t decimals);
+/// kAxes coordinates separated by commas: um printed as mm with 3 decimals, or as inches with
+/// 4 decimals when $13=1 (exact conversion, half away from zero).
+void coords(const int32_t* um);
+/// A rate given in units/min x1000: mm/min without decimals, or in/min with 1 decimal ($13=1),
+/// as GRBL prints F and FS.
+void rate(uint32_t milli_per_min);
+/// `ok` for status::kOk, `error:N` otherwise, then the line end.
+void status(uint8_t code);
+/// `[MSG:text]` and the line end.
+void msg(const FlashChar* text);
+
+} // namespace out
+} // namespace ll
