@@ -34,9 +34,33 @@ Num norm(const uint32_t v[kAxes]) {
 
 } // namespace
 
+void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out) {
+    // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated
+    // length: Euclidean over the move's group (seed §3.1).
+    uint32_t x[kAxes], xg[kAxes];
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
+        xg[a] = (group & (1u << a)) ? x[a] : 0;
+    }
+    out.len_q8 = norm(xg).u32();
+    if (out.len_q8 == 0) out.len_q8 = 1;
+    Num len(out.len_q8);
+    out.vmax = limit_along(m.max_rate, x, len);
+    out.accel = limit_along(m.accel, x, len);
+    if (out.accel == 0) out.accel = 1;
+}
+
+int32_t Planner::delta(const PlanBlock& b, uint8_t axis) {
+    const uint8_t* d = b.delta[axis];
+    uint32_t v = d[0] | static_cast<uint32_t>(d[1]) << 8 | static_cast<uint32_t>(d[2]) << 16;
+    if (v & 0x800000ul) v |= 0xFF000000ul; // sign extension
+    return static_cast<int32_t>(v);
+}
+
 void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
     head_ = 0;
     count_ = 0;
+    first_begun_ = 0;
     prev_group_ = 0;
     for (uint8_t a = 0; a < kAxes; ++a) {
         last_[a] = steps[a];
@@ -84,38 +108,28 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
                   bool rapid) {
     PlanBlock& b = ring_[index(count_)];
     bool moves = false;
-    int32_t du[kAxes];
+    int32_t d[kAxes], du[kAxes];
     for (uint8_t a = 0; a < kAxes; ++a) {
-        b.delta[a] = target[a] - last_[a];
+        d[a] = target[a] - last_[a];
         du[a] = target_um[a] - last_um_[a];
-        if (b.delta[a] != 0) moves = true;
+        if (d[a] != 0) moves = true;
     }
     for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
     if (!moves) return false;
-    for (uint8_t a = 0; a < kAxes; ++a) last_[a] = target[a];
-
-    // Per-axis travel in µm x 256 (units of the axis: mm or degrees), from the steps that will
-    // be travelled, and the regulated length: Euclidean over the move's group (seed §3.1).
-    b.group = regulated_group(*m_, b.delta);
-    uint32_t x[kAxes], xg[kAxes];
     for (uint8_t a = 0; a < kAxes; ++a) {
-        x[a] = m_->um_q8_per_step[a].of(abs32(b.delta[a]));
-        xg[a] = (b.group & (1u << a)) ? x[a] : 0;
+        last_[a] = target[a];
+        uint32_t v = static_cast<uint32_t>(d[a]);
+        b.delta[a][0] = static_cast<uint8_t>(v);
+        b.delta[a][1] = static_cast<uint8_t>(v >> 8);
+        b.delta[a][2] = static_cast<uint8_t>(v >> 16);
     }
-    b.len_q8 = norm(xg).u32();
-    if (b.len_q8 == 0) b.len_q8 = 1;
-    Num len(b.len_q8);
-
-    // Limits along the move: every axis (in the regulated group or following it) keeps to its
-    // own maximum rate and acceleration.
-    uint32_t vmax = limit_along(m_->max_rate, x, len);
-    b.accel = limit_along(m_->accel, x, len);
-    if (b.accel == 0) b.accel = 1;
-    b.feed = rapid || feed > vmax ? vmax : feed;
+    b.group = regulated_group(*m_, d);
+    MoveLimits lim;
+    move_limits(*m_, d, b.group, lim);
+    b.feed = rapid || feed > lim.vmax ? lim.vmax : feed;
     if (b.feed == 0) b.feed = 1;
     // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000.
-    b.dv2 = len.mul(b.accel).div(128000).u32();
-    b.begun = 0;
+    b.dv2 = Num(lim.len_q8).mul(lim.accel).div(128000).u32();
 
     // Unit vector of the commanded move (Q29), for the junction.
     int32_t unit[kAxes];
@@ -143,9 +157,8 @@ void Planner::recalculate() {
     // Backward pass: each move must be able to slow down to the next one's entry (0 after the
     // last move). The move being executed keeps its entry speed.
     uint32_t next_entry = 0;
-    for (uint8_t i = count_; i-- > 0;) {
+    for (uint8_t i = count_; i-- > first_begun_;) {
         PlanBlock& b = ring_[index(i)];
-        if (b.begun) break;
         b.v_entry2 = min32(b.v_max_entry2, add_sat(next_entry, b.dv2));
         next_entry = b.v_entry2;
     }
@@ -153,7 +166,6 @@ void Planner::recalculate() {
     for (uint8_t i = 0; i + 1 < count_; ++i) {
         const PlanBlock& b = ring_[index(i)];
         PlanBlock& n = ring_[index(static_cast<uint8_t>(i + 1))];
-        if (n.begun) continue;
         uint32_t reach = add_sat(b.v_entry2, b.dv2);
         if (n.v_entry2 > reach) n.v_entry2 = reach;
     }
@@ -162,9 +174,11 @@ void Planner::recalculate() {
 MoveSpec Planner::spec_of_first() const {
     const PlanBlock& b = ring_[head_];
     MoveSpec s;
-    for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = b.delta[a];
-    s.len_q8 = b.len_q8;
-    s.accel = b.accel;
+    for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(b, a);
+    MoveLimits lim;
+    move_limits(*m_, s.delta, b.group, lim);
+    s.len_q8 = lim.len_q8;
+    s.accel = lim.accel;
     s.feed = b.feed;
     s.v_entry2 = b.v_entry2;
     s.v_nominal2 = nominal2(b);
@@ -177,28 +191,19 @@ uint32_t Planner::exit2_of_first() const {
     return count_ > 1 ? ring_[index(1)].v_entry2 : 0;
 }
 
-void Planner::begin_first() {
-    if (count_) ring_[head_].begun = 1;
-}
-
 void Planner::discard_first() {
     if (!count_) return;
     head_ = index(1);
     --count_;
+    first_begun_ = 0;
 }
 
 void Planner::restart_first(uint32_t remaining, uint32_t total) {
     if (!count_) return;
     PlanBlock& b = ring_[head_];
-    if (total != 0) {
-        Num f(remaining);
-        f.div(total);
-        b.len_q8 = f.of(b.len_q8);
-        b.dv2 = f.of(b.dv2);
-    }
+    if (total != 0) b.dv2 = Num(remaining).div(total).of(b.dv2);
     b.v_entry2 = 0;
-    b.begun = 1;
-    for (uint8_t i = 1; i < count_; ++i) ring_[index(i)].begun = 0;
+    first_begun_ = 1;
     recalculate();
 }
 

@@ -13,9 +13,10 @@
 
 namespace ll {
 
-/// Longest reference-axis distance of one line, ticks. Keeps S_j * L + P within 32 bits
-/// (k <= 27 with P >= 8 d_1). Longer moves are split by the planner.
-constexpr uint32_t kMaxLineTicks = 1ul << 24;
+/// Longest distance of one line on any axis, ticks (8.4 million: 104 m at 80 steps/mm). It keeps
+/// S_j * L + P within 32 bits (k <= 26 with P >= 8 d_1) and a planned move's deltas within
+/// 24 bits. The G-code layer refuses longer moves (error:33).
+constexpr uint32_t kMaxLineTicks = (1ul << 23) - 1;
 /// Longest macro segment (reference-axis ticks between two computed positions).
 constexpr uint8_t kMaxSegmentTicks = 16;
 

@@ -23,7 +23,7 @@ void init();
 bool can_accept();
 /// Queues a move. Precondition: can_accept(). A move of zero length is dropped silently (as
 /// GRBL does) but still counts as accepted. Returns false, queueing nothing, when one axis
-/// would travel more than kMaxLineTicks steps (2^24) in one move: the G-code layer reports it
+/// would travel more than kMaxLineTicks steps (2^23 - 1) in one move: the G-code layer reports it
 /// as an invalid target (error:33) rather than running part of it.
 bool push_line(const LineRequest& req);
 /// Free planner blocks (first field of `Bf:`).

@@ -2,6 +2,10 @@
 // junction deviation (GRBL's $11 model) and by what the following moves can still decelerate
 // from, recomputed as moves arrive (backward then forward pass). Speeds are squared, in
 // (units/min)^2 of each move's regulated path (seed §3.1); integer only.
+//
+// A queued move costs 29 bytes of RAM (16 of them fit in the ATmega328P's budget): deltas are
+// kept on 24 bits, and what can be derived from them again (length, acceleration limit) is
+// recomputed when the move starts instead of being stored.
 #pragma once
 
 #include "lowlevel/machine.h"
@@ -10,17 +14,24 @@
 namespace ll {
 
 struct PlanBlock {
-    int32_t delta[kAxes];  ///< steps per machine axis
-    uint32_t len_q8;       ///< regulated path length, µm x 256
-    uint32_t accel;        ///< acceleration along the path, units/min^2
-    uint32_t feed;         ///< nominal speed, units/min x1000
-    uint32_t dv2;          ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
-    uint32_t v_entry2;     ///< planned entry speed squared
-    uint32_t v_max_entry2; ///< junction and nominal limit on the entry speed squared
-    uint8_t group;         ///< regulated axes
-    uint8_t begun;         ///< 1 once the step generator started it: its entry is fixed
+    uint8_t delta[kAxes][3]; ///< steps per machine axis, signed 24-bit little-endian
+    uint8_t group;           ///< regulated axes (seed §3.1)
+    uint32_t feed;           ///< nominal speed, units/min x1000
+    uint32_t dv2;            ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
+    uint32_t v_entry2;       ///< planned entry speed squared
+    uint32_t v_max_entry2;   ///< junction and nominal limit on the entry speed squared
 };
 
+/// Length, acceleration and speed limit of a move along its regulated path (every axis, in
+/// the group or following it, kept within its own maximum rate and acceleration).
+struct MoveLimits {
+    uint32_t len_q8; ///< µm x 256
+    uint32_t accel;  ///< units/min^2
+    uint32_t vmax;   ///< units/min x1000
+};
+void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out);
+
+/// Zero-initialised as a global (or with `Planner p{}`): no constructor, no start-up code.
 class Planner {
   public:
     void configure(const Machine* m) { m_ = m; }
@@ -37,16 +48,19 @@ class Planner {
     /// targets to whole steps does not turn a smooth chain of short segments into a zigzag of
     /// corners. The length (and so the feed) comes from the steps actually travelled. `feed` is
     /// in units/min x1000 along the regulated path; `rapid` uses every axis' maximum rate.
-    /// Returns false when no axis moves (nothing queued). Precondition: !full().
+    /// Returns false when no axis moves (nothing queued). Preconditions: !full(), and no axis
+    /// travels more than kMaxLineTicks.
     bool add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
              bool rapid);
 
-    PlanBlock* first() { return count_ ? &ring_[head_] : nullptr; }
+    /// The i-th queued move (0 = oldest). Precondition: i < count().
+    const PlanBlock& block(uint8_t i) const { return ring_[index(i)]; }
     /// The oldest move as the step generator needs it (entry and planned exit speeds).
     MoveSpec spec_of_first() const;
     /// Planned exit speed squared of the oldest move (the next one's entry, 0 at the end).
     uint32_t exit2_of_first() const;
-    void begin_first();
+    /// The step generator started the oldest move: its entry speed is now fixed.
+    void begin_first() { first_begun_ = 1; }
     void discard_first();
 
     /// After a feed hold stopped the oldest move with `remaining` of its `total` reference
@@ -58,6 +72,7 @@ class Planner {
 
     /// Nominal speed squared of a move, (units/min)^2.
     static uint32_t nominal2(const PlanBlock& b);
+    static int32_t delta(const PlanBlock& b, uint8_t axis);
 
   private:
     uint8_t index(uint8_t i) const { return static_cast<uint8_t>((head_ + i) % kPlannerSize); }
@@ -65,13 +80,14 @@ class Planner {
     uint32_t junction2(const int32_t unit[kAxes]) const;
 
     const Machine* m_;
-    PlanBlock ring_[kPlannerSize];
     uint8_t head_;
     uint8_t count_;
+    uint8_t first_begun_; ///< the oldest move is in the step generator: its entry is fixed
+    uint8_t prev_group_;  ///< 0: no previous move (start from rest)
     int32_t last_[kAxes];
     int32_t last_um_[kAxes];
     int32_t prev_unit_[kAxes]; ///< unit vector of the last move, Q29
-    uint8_t prev_group_;       ///< 0: no previous move (start from rest)
+    PlanBlock ring_[kPlannerSize];
 };
 
 } // namespace ll
