@@ -1,7 +1,15 @@
-// Placeholder firmware entry point (replaced by the firmware issue).
-#include <avr/io.h>
+// Firmware entry point: hardware first (interrupts off), then the portable main loop.
+#include <avr/interrupt.h>
+
+#include "fw.h"
+#include "lowlevel/app.h"
 
 int main() {
-    for (;;) {
-    }
+    ll::fw::board_init();
+    ll::fw::stepper_init();
+    ll::fw::clock_init();
+    ll::fw::serial_init();
+    sei();
+    ll::app::init();
+    for (;;) ll::app::run_once();
 }

@@ -2,7 +2,7 @@
 # Installs the Debian packages Low Level needs, only those that are missing.
 # Usage: tools/deps.sh [test|demo]   (sourced or run; needs root or sudo when something is missing)
 set -euo pipefail
-pkgs=(cmake make g++ gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev
+pkgs=(cmake make g++ gcc-avr avr-libc binutils-avr avrdude simavr libsimavr-dev libelf-dev
       libgtest-dev pkg-config)
 missing=()
 for p in "${pkgs[@]}"; do

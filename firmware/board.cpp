@@ -1,0 +1,45 @@
+// Pin directions, limit inputs and critical sections (board.h has the map).
+#include <avr/io.h>
+
+#include "board.h"
+#include "fw.h"
+#include "lowlevel/hal.h"
+#include "lowlevel/settings.h"
+
+namespace ll {
+namespace fw {
+
+void board_init() {
+    // Step and direction outputs start low; stepper_configure() applies $2. Enable starts at
+    // "disabled" for $4 = 0 (high) until stepper_init() sets it properly.
+    PORTD = static_cast<uint8_t>(PORTD & ~(board::kStepMaskD | board::kDirMaskD));
+    DDRD = static_cast<uint8_t>(DDRD | board::kStepMaskD | board::kDirMaskD);
+    PORTB = static_cast<uint8_t>((PORTB & ~(board::kStepMaskB | board::kDirMaskB)) |
+                                 board::Enable::kMask | board::kLimitMaskB);
+    DDRB = static_cast<uint8_t>(
+        (DDRB | board::kStepMaskB | board::kDirMaskB | board::Enable::kMask) & ~board::kLimitMaskB);
+}
+
+} // namespace fw
+
+namespace hal {
+
+uint8_t limits() {
+    // Pull-ups: an open switch reads high. $5 = 0: a switch closing to ground triggers.
+    uint8_t pins = static_cast<uint8_t>(PINB >> board::LimitX::kBit) & 0x07;
+    return g_settings.limit_invert ? pins : static_cast<uint8_t>(pins ^ 0x07);
+}
+
+uint8_t irq_save() {
+    uint8_t s = SREG;
+    asm volatile("cli" ::: "memory");
+    return s;
+}
+
+void irq_restore(uint8_t state) {
+    asm volatile("" ::: "memory");
+    SREG = state;
+}
+
+} // namespace hal
+} // namespace ll

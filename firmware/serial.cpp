@@ -1,0 +1,168 @@
+// UART0: 115200 baud 8N1 (U2X0 = 1, UBRR0 = 16, as GRBL), interrupt-driven in both directions.
+//
+// Neither handler may delay the step interrupt by more than a few cycles, so both re-enable
+// interrupts as soon as their source is cleared:
+//   - receive: a naked stub disables the receive interrupt (one constant store: nothing else
+//     ever changes UCSR0B) and re-enables interrupts, 8 cycles after the vector; the rest runs
+//     interruptible in rx_drain(), which empties the 2-byte hardware FIFO in arrival order and
+//     then re-enables the receive interrupt. Order can never be swapped by a nested receive.
+//   - transmit: the "transmit complete" interrupt (its flag clears itself when the vector
+//     runs), so the handler starts with sei (ISR_NOBLOCK). It refills UDR0 with up to two
+//     bytes (shift register + buffer). The "data register empty" interrupt would need UDRIE
+//     toggled, i.e. a read-modify-write of UCSR0B shared with the receive stub.
+#include <avr/interrupt.h>
+#include <avr/io.h>
+
+#include "fw.h"
+#include "lowlevel/hal.h"
+#include "lowlevel/realtime.h"
+
+namespace ll {
+namespace {
+
+constexpr uint8_t kUbrr = 16; // 16 MHz / (8 * (16 + 1)) = 117647 baud, +2.1 % (as GRBL)
+constexpr uint8_t kUcsr0bRun = _BV(RXCIE0) | _BV(TXCIE0) | _BV(RXEN0) | _BV(TXEN0);
+constexpr uint8_t kUcsr0bRxMasked = _BV(TXCIE0) | _BV(RXEN0) | _BV(TXEN0);
+
+// Receive ring: 128 bytes, all usable (senders' character counting sends 128 bytes
+// unacknowledged). Indices run freely over 0..255; the slot is index & 127.
+constexpr uint16_t kRxSize = 128;
+// Transmit ring: 64 bytes. A status report (~90 bytes) waits for about 26 bytes to leave
+// (2.3 ms); longer waits only happen while printing $$ or $# when idle.
+constexpr uint16_t kTxSize = 64;
+static_assert(kRxSize <= 128 && (kRxSize & (kRxSize - 1)) == 0, "free-running 8-bit indices");
+static_assert(kTxSize <= 128 && (kTxSize & (kTxSize - 1)) == 0, "free-running 8-bit indices");
+
+uint8_t s_rx_buf[kRxSize];
+volatile uint8_t s_rx_head;     // consumer: main loop
+volatile uint8_t s_rx_tail;     // producer: receive handler
+volatile uint8_t s_rx_overflow; // a byte was lost (buffer full or hardware overrun)
+
+uint8_t s_tx_buf[kTxSize];
+volatile uint8_t s_tx_head;   // consumer: transmit handler (or serial_put when idle)
+volatile uint8_t s_tx_tail;   // producer: main loop
+volatile uint8_t s_tx_active; // a "transmit complete" interrupt is still to come
+
+void rx_push(uint8_t byte) {
+    if (rt::filter(byte)) return;
+    uint8_t t = s_rx_tail;
+    if (static_cast<uint8_t>(t - s_rx_head) >= kRxSize) {
+        s_rx_overflow = 1;
+        return;
+    }
+    s_rx_buf[t & (kRxSize - 1)] = byte;
+    s_rx_tail = static_cast<uint8_t>(t + 1);
+}
+
+} // namespace
+} // namespace ll
+
+// Interruptible tail of the receive interrupt. Named __vector_* so that avr-gcc accepts the
+// `signal` attribute (saves what it uses, ends with reti) on a function that is not a vector.
+extern "C" void __vector_rx_drain() __attribute__((signal, used, externally_visible));
+void __vector_rx_drain() {
+    using namespace ll;
+    do {
+        uint8_t status = UCSR0A;
+        uint8_t byte = UDR0;
+        if (status & _BV(DOR0)) s_rx_overflow = 1; // the hardware lost a byte before this one
+        rx_push(byte);
+    } while (UCSR0A & _BV(RXC0));
+    UCSR0B = kUcsr0bRun; // a byte that arrived meanwhile raises the interrupt again at once
+}
+
+ISR(USART_RX_vect, ISR_NAKED) {
+    asm volatile("push r24\n\t"
+                 "ldi  r24, %[masked]\n\t"
+                 "sts  %[ucsr0b], r24\n\t"
+                 "sei\n\t"
+                 "pop  r24\n\t"
+                 "rjmp __vector_rx_drain\n\t"
+                 :
+                 : [masked] "M"(ll::kUcsr0bRxMasked), [ucsr0b] "n"(_SFR_MEM_ADDR(UCSR0B)));
+}
+
+ISR(USART_TX_vect, ISR_NOBLOCK) {
+    using namespace ll;
+    uint8_t h = s_tx_head;
+    uint8_t t = s_tx_tail;
+    if (h == t) {
+        s_tx_active = 0;
+        return;
+    }
+    // The shift register is empty: the first byte goes straight into it, the second waits in
+    // UDR0, so the line stays busy for two frames per interrupt.
+    do {
+        UDR0 = s_tx_buf[h & (kTxSize - 1)];
+        h = static_cast<uint8_t>(h + 1);
+    } while (h != t && (UCSR0A & _BV(UDRE0)));
+    s_tx_head = h;
+}
+
+namespace ll {
+namespace fw {
+
+void serial_init() {
+    UBRR0H = 0;
+    UBRR0L = kUbrr;
+    UCSR0A = _BV(U2X0);
+    UCSR0C = _BV(UCSZ01) | _BV(UCSZ00); // 8N1
+    UCSR0B = kUcsr0bRun;
+}
+
+} // namespace fw
+
+namespace hal {
+
+bool serial_get(uint8_t& byte) {
+    uint8_t h = s_rx_head;
+    if (h == s_rx_tail) return false;
+    byte = s_rx_buf[h & (kRxSize - 1)];
+    s_rx_head = static_cast<uint8_t>(h + 1);
+    return true;
+}
+
+uint8_t serial_rx_free() {
+    return static_cast<uint8_t>(kRxSize - static_cast<uint8_t>(s_rx_tail - s_rx_head));
+}
+
+bool serial_rx_overflowed() {
+    fw::IrqGuard g;
+    uint8_t o = s_rx_overflow;
+    s_rx_overflow = 0;
+    return o != 0;
+}
+
+void serial_rx_clear() {
+    s_rx_head = s_rx_tail;
+}
+
+void serial_put(uint8_t byte) {
+    uint8_t t = s_tx_tail;
+    while (static_cast<uint8_t>(t - s_tx_head) >= kTxSize) {
+        // Full, so a transmission is under way: the interrupt frees a slot within two frames.
+    }
+    s_tx_buf[t & (kTxSize - 1)] = byte;
+    s_tx_tail = static_cast<uint8_t>(t + 1);
+    uint8_t was_active;
+    {
+        fw::IrqGuard g; // test-and-set, 4 cycles
+        was_active = s_tx_active;
+        s_tx_active = 1;
+    }
+    if (!was_active) {
+        // The transmitter was idle and no completion is pending, so the interrupt cannot run
+        // before this byte has left: take it from the ring here.
+        uint8_t h = s_tx_head;
+        UDR0 = s_tx_buf[h & (kTxSize - 1)];
+        s_tx_head = static_cast<uint8_t>(h + 1);
+    }
+}
+
+void serial_flush() {
+    while (s_tx_active) {
+    }
+}
+
+} // namespace hal
+} // namespace ll
