@@ -21,6 +21,9 @@ endforeach()
 math(EXPR expect_edge "${kStepEdgeOffsetD} - ${kVectorEntryCycles}")
 
 string(REPLACE ";" "#" dis "${dis}") # objdump comments use ';', a CMake list separator
+# Brackets (in flash strings dumped as ASCII, e.g. "[VER:") would stop CMake from splitting.
+string(REPLACE "[" "(" dis "${dis}")
+string(REPLACE "]" ")" dis "${dis}")
 string(REPLACE "\n" ";" lines "${dis}")
 string(REPLACE "," ";" vectors "${VECTORS}")
 foreach(vec ${vectors})

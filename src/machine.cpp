@@ -1,5 +1,7 @@
 #include "lowlevel/machine.h"
 
+#include "lowlevel/step_timing.h"
+
 namespace ll {
 
 void machine_build(Machine& m, const Settings& s) {
@@ -22,8 +24,8 @@ void machine_build(Machine& m, const Settings& s) {
     }
     step_lengths_build(m.lengths, spm);
     m.junction_dev_um = s.junction_dev;
-    uint32_t minp = static_cast<uint32_t>(s.pulse_us) * (kCpuHz / 1000000) + kPeriodMargin;
-    m.min_period = static_cast<uint16_t>(minp > 0xFFFF ? 0xFFFF : minp);
+    // The step interrupt's own contract (step_timing.h): pulse width plus the run-change path.
+    m.min_period = step_timing::min_period(static_cast<uint16_t>(s.pulse_us * (kCpuHz / 1000000)));
 }
 
 uint8_t regulated_group(const Machine& m, const int32_t delta_steps[kAxes]) {

@@ -199,8 +199,7 @@ void position(int32_t steps[kAxes]) {
         cur_steps = g_exec.steps;
         cur_dirs = g_exec.dirs;
     }
-    const int32_t* pushed = m.gen.pushed_position();
-    for (uint8_t a = 0; a < kAxes; ++a) steps[a] = pushed[a];
+    m.gen.pushed_position(steps);
     // Undo what is queued but not executed: the rest of the current run, then every run
     // between the consumer and the producer.
     auto undo = [&](uint8_t s, uint8_t d, uint8_t n) {

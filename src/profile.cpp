@@ -4,27 +4,15 @@
 
 namespace ll {
 
-ProfileShape profile_shape(const Profile& p) {
-    ProfileShape sh;
+uint32_t profile_x2_decel(const Profile& p) {
     const uint8_t half = static_cast<uint8_t>(p.log_s - 1); // s / 2 = 2^half
-    uint32_t sd = shl_sat(p.d, p.log_s);
-    // Start change: accelerate (or decelerate) until A reaches A_cruise.
-    uint32_t change = p.a_entry <= p.a_cruise ? p.a_cruise - p.a_entry : p.a_entry - p.a_cruise;
-    // End deceleration: from A_cruise down to A_exit.
-    uint32_t decel = p.a_cruise - p.a_exit;
-    if (p.a_entry <= p.a_cruise && add_sat(change, decel) > sd) {
-        // Too short to reach cruise: the start and end lines meet at the closed-form peak.
-        sh.reaches_cruise = false;
-        sh.a_peak = (add_sat(p.a_entry, p.a_exit) >> 1) + (sd >> 1);
-        // 2 x_decel = (A_exit + s d - A_entry) / s
-        sh.x_change = sh.x_decel = (add_sat(p.a_exit, sd) - p.a_entry) >> p.log_s;
-        return sh;
+    uint32_t drop = (p.a_cruise - p.a_exit) >> half; // half ticks to decelerate from cruise
+    uint32_t x2 = drop >= 2 * p.d ? 0 : 2 * p.d - drop;
+    if (p.a_entry <= p.a_cruise) {
+        uint32_t meet = (add_sat(p.a_exit, shl_sat(p.d, p.log_s)) - p.a_entry) >> p.log_s;
+        if (meet > x2) x2 = meet;
     }
-    sh.reaches_cruise = true;
-    sh.a_peak = p.a_cruise;
-    sh.x_change = change >> half;
-    sh.x_decel = 2 * p.d - (decel >> half);
-    return sh;
+    return x2;
 }
 
 uint32_t profile_a(const Profile& p, uint32_t x2) {
@@ -46,7 +34,6 @@ void SqrtTracker::reset(uint32_t a) {
     r = isqrt32(a);
     c = r * r;
     c_next = c + 2 * r + 1;
-    steps = 0;
 }
 
 bool SqrtTracker::seek(uint32_t a) {
@@ -72,11 +59,7 @@ bool SqrtTracker::seek(uint32_t a) {
             }
         }
     }
-    if (r != before) {
-        ++steps;
-        return true;
-    }
-    return false;
+    return r != before;
 }
 
 } // namespace ll

@@ -31,8 +31,16 @@ void StepGen::configure(const StepLengths* lengths, uint16_t min_period) {
 }
 
 bool StepGen::begin(const MoveSpec& spec) {
-    if (!line_setup(line_, spec.delta)) return false;
-    spec_ = spec;
+    pushed_position(start_); // the previous move is complete: start from its end
+    if (!line_setup(line_, spec.delta)) {
+        line_.m = 0;
+        return false;
+    }
+    len_q8_ = spec.len_q8;
+    accel_ = spec.accel;
+    feed_ = spec.feed;
+    v_nominal2_ = spec.v_nominal2;
+    v_exit2_ = spec.v_exit2;
     line_start(line_, cursor_);
     build_k_table(spec.group);
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
@@ -108,13 +116,13 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     // Fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
     // l = v^2 rho / (2 a), rho = 1000 d_1 / len_um = 256000 d_1 / len_q8 ticks per mm.
     Num phi(128000);
-    phi.mul(d1).div(spec_.len_q8).div(spec_.accel);
+    phi.mul(d1).div(len_q8_).div(accel_);
     // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)), len_um = len_q8 / 256.
-    Num dn(spec_.len_q8, -7);
-    dn.div(spec_.accel).div(d1).sqrt().mul(kSqrtCHalf).shift(1);
+    Num dn(len_q8_, -7);
+    dn.div(accel_).div(d1).sqrt().mul(kSqrtCHalf).shift(1);
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 and D below 2^32
     // (D grows as sqrt(s) = 2^m sqrt(2)).
-    uint32_t l_max = add_sat(phi.of(max3(v_entry2, spec_.v_nominal2, v_exit2)), remaining_ticks);
+    uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);
     uint8_t m = 4;
     while (m > 0 && (shl_sat(l_max, static_cast<uint8_t>(2 * m + 1)) > kMaxA ||
                      Num(dn).shift(static_cast<int8_t>(m)).u32() == 0xFFFFFFFFul)) {
@@ -124,23 +132,23 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     a_per_v2_ = phi.shift(static_cast<int8_t>(prof_.log_s));
     prof_.d = remaining_ticks;
     prof_.a_entry = a_of(v_entry2);
-    prof_.a_cruise = a_of(spec_.v_nominal2);
+    prof_.a_cruise = a_of(v_nominal2_);
     prof_.a_exit = a_of(v_exit2);
     if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
-    prof_.cruise = Num(kCruiseNum).mul(spec_.len_q8).div(spec_.feed).div(d1).u32();
-    x2_decel_ = profile_shape(prof_).x_decel;
+    prof_.cruise = Num(kCruiseNum).mul(len_q8_).div(feed_).div(d1).u32();
+    x2_decel_ = profile_x2_decel(prof_);
     root_valid_ = false;
 }
 
 void StepGen::set_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
     if (2 * (cursor_.x1 - origin_) >= x2_decel_) return; // end deceleration already begun
-    spec_.v_exit2 = v_exit2;
+    v_exit2_ = v_exit2;
     prof_.a_exit = a_of(v_exit2);
     if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
-    x2_decel_ = profile_shape(prof_).x_decel;
+    x2_decel_ = profile_x2_decel(prof_);
 }
 
 void StepGen::hold() {
@@ -156,7 +164,7 @@ void StepGen::resume(uint32_t v_exit2) {
     holding_ = false;
     if (!stopped_) return;
     stopped_ = false;
-    spec_.v_exit2 = v_exit2;
+    v_exit2_ = v_exit2;
     origin_ = cursor_.x1;
     prepare_profile(0, v_exit2, line_.dist[0] - cursor_.x1);
     seg_len_ = 1;
@@ -167,8 +175,19 @@ uint32_t StepGen::speed2() const {
     return Num(a_last_).div(a_per_v2_).u32();
 }
 
+void StepGen::pushed_position(int32_t out[kAxes]) const {
+    for (uint8_t a = 0; a < kAxes; ++a) out[a] = start_[a];
+    for (uint8_t j = 0; j < line_.m; ++j) {
+        uint8_t a = line_.axis[j];
+        int32_t p = static_cast<int32_t>(cursor_.pos[j]);
+        out[a] += (line_.dirs & (1u << a)) ? -p : p;
+    }
+}
+
 void StepGen::set_position(const int32_t steps[kAxes]) {
-    for (uint8_t a = 0; a < kAxes; ++a) pos_[a] = steps[a];
+    for (uint8_t a = 0; a < kAxes; ++a) start_[a] = steps[a];
+    line_.m = 0;
+    active_ = false;
 }
 
 void StepGen::abort() {
@@ -229,15 +248,6 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8
 #endif
         }
     }
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        if (steps & (1u << a)) {
-            if (dirs & (1u << a)) {
-                pos_[a] -= count;
-            } else {
-                pos_[a] += count;
-            }
-        }
-    }
 }
 
 uint8_t StepGen::fill(RunQueue& q) {
@@ -281,7 +291,6 @@ uint8_t StepGen::fill(RunQueue& q) {
             delta = delta_root_;
             if (a <= prof_.a_cruise && delta < prof_.cruise) delta = prof_.cruise;
         }
-        delta_q8_ = delta;
 
         uint8_t e[kAxes];
         line_advance(line_, cursor_, len, e);
@@ -310,7 +319,7 @@ uint8_t StepGen::fill(RunQueue& q) {
         if (cursor_.x1 == line_.dist[0]) {
             active_ = false;
             have_handover_ = true;
-            handover_v2_ = holding_ ? speed2() : spec_.v_exit2;
+            handover_v2_ = holding_ ? speed2() : v_exit2_;
         }
     }
     return static_cast<uint8_t>(q.used() - pushed_before);

@@ -68,30 +68,27 @@ const lltest::Machine kMachine{80, 80, 80, 80};
 
 TEST(ProfileShape, PeakAndDecelerationPointComeFromTheClosedForm) {
     ll::Profile p{};
-    p.log_s = 1;
+    p.log_s = 1; // s = 2
     p.d = 1000;
     p.a_entry = 100;
     p.a_cruise = 1000000; // unreachable
     p.a_exit = 300;
-    ll::ProfileShape sh = ll::profile_shape(p);
-    EXPECT_FALSE(sh.reaches_cruise);
-    // v_p^2 = (v0^2 + v1^2)/2 + a L  <=>  A_p = (A_entry + A_exit + s d) / 2
-    EXPECT_EQ(sh.a_peak, (100u + 300u + 2000u) / 2);
     // x_decel = (A_exit - A_entry + s d) / (2 s) = 550 ticks = 1100 half ticks
-    EXPECT_EQ(sh.x_decel, 1100u);
-    // The profile's switch from accelerating to decelerating happens exactly there.
-    EXPECT_EQ(ll::profile_a(p, 1100), sh.a_peak);
-    EXPECT_LT(ll::profile_a(p, 1099), sh.a_peak);
-    EXPECT_LT(ll::profile_a(p, 1101), sh.a_peak);
+    uint32_t x2 = ll::profile_x2_decel(p);
+    EXPECT_EQ(x2, 1100u);
+    // The switch from accelerating to decelerating happens exactly there, at the closed-form
+    // peak v_p^2 = (v0^2 + v1^2)/2 + a L  <=>  A_p = (A_entry + A_exit + s d) / 2.
+    EXPECT_EQ(ll::profile_a(p, x2), (100u + 300u + 2000u) / 2);
+    EXPECT_LT(ll::profile_a(p, x2 - 1), ll::profile_a(p, x2));
+    EXPECT_LT(ll::profile_a(p, x2 + 1), ll::profile_a(p, x2));
 
     p.a_cruise = 1000; // reachable: accelerate 450 ticks, cruise, decelerate 350 ticks
-    sh = ll::profile_shape(p);
-    EXPECT_TRUE(sh.reaches_cruise);
-    EXPECT_EQ(sh.x_change, 900u);
-    EXPECT_EQ(sh.x_decel, 2 * (1000u - 350u));
-    EXPECT_EQ(ll::profile_a(p, 900), 1000u);
-    EXPECT_EQ(ll::profile_a(p, 1300), 1000u);
-    EXPECT_LT(ll::profile_a(p, 1302), 1000u);
+    x2 = ll::profile_x2_decel(p);
+    EXPECT_EQ(x2, 2 * (1000u - 350u));
+    EXPECT_EQ(ll::profile_a(p, 900), 1000u); // cruise reached after 450 ticks
+    EXPECT_LT(ll::profile_a(p, 898), 1000u);
+    EXPECT_EQ(ll::profile_a(p, x2), 1000u);
+    EXPECT_LT(ll::profile_a(p, x2 + 2), 1000u);
 }
 
 TEST(ProfileShape, EntryAboveCruiseDeceleratesAtTheStartOnly) {
@@ -101,11 +98,10 @@ TEST(ProfileShape, EntryAboveCruiseDeceleratesAtTheStartOnly) {
     p.a_entry = 1500;
     p.a_cruise = 1000;
     p.a_exit = 0;
-    ll::ProfileShape sh = ll::profile_shape(p);
-    EXPECT_TRUE(sh.reaches_cruise);
-    EXPECT_EQ(sh.x_change, 500u); // 250 ticks to shed 500 units of A at s = 2
     EXPECT_EQ(ll::profile_a(p, 0), 1500u);
-    EXPECT_EQ(ll::profile_a(p, 500), 1000u);
+    EXPECT_GT(ll::profile_a(p, 498), 1000u);
+    EXPECT_EQ(ll::profile_a(p, 500), 1000u); // 250 ticks to shed 500 units of A at s = 2
+    EXPECT_EQ(ll::profile_x2_decel(p), 1000u);
     EXPECT_EQ(ll::profile_a(p, 2000), 0u);
 }
 
@@ -161,7 +157,8 @@ TEST(SpeedProfile, TriangleWhenCruiseIsOutOfReach) {
         fastest = std::max(fastest, kF / static_cast<double>(ev[k].t - ev[k - 1].t));
     }
     EXPECT_NEAR(fastest, std::sqrt(80000.0 * 120), 0.02 * std::sqrt(80000.0 * 120));
-    EXPECT_FALSE(ll::profile_shape(gen.profile()).reaches_cruise);
+    const ll::Profile& pr = gen.profile();
+    EXPECT_LT(ll::profile_a(pr, ll::profile_x2_decel(pr)), pr.a_cruise); // never cruises
 }
 
 TEST(SpeedProfile, ToleranceHoldsAcrossResolutionsAndAccelerations) {

@@ -19,10 +19,6 @@ struct Machine {
     uint16_t min_period;       ///< shortest step period the interrupt honours, CPU cycles
 };
 
-/// Extra cycles the step interrupt needs beyond the pulse width between two steps (pulse-end
-/// interrupt latency and direction setup), from the firmware's measurements.
-constexpr uint16_t kPeriodMargin = 48;
-
 void machine_build(Machine& m, const Settings& s);
 
 /// The regulated group of a move (seed §3.1, LinuxCNC/g2core rule): the group of the first

@@ -32,14 +32,13 @@ struct Profile {
     uint32_t cruise;   ///< Delta_1 at cruise, CPU cycles x 256 (exact: one division per move)
 };
 
-/// The closed-form shape of a profile (seed §4.1, docs/motion.md "Peak and deceleration point").
-struct ProfileShape {
-    bool reaches_cruise;
-    uint32_t a_peak;   ///< highest (or, decelerating at the start, lowest) A of the move
-    uint32_t x_change; ///< reference ticks x 2 where the start change ends
-    uint32_t x_decel;  ///< reference ticks x 2 where the end deceleration starts
-};
-ProfileShape profile_shape(const Profile& p);
+/// Where the end deceleration starts, in half ticks, from the closed form (seed §4.1,
+/// docs/motion.md "Peak and deceleration point"): with x_d = d - (A_cruise - A_exit) / s the
+/// point where the end line leaves cruise and x* = (A_exit - A_entry + s d) / (2 s) the point
+/// where the start and end lines meet, the move decelerates from max(x_d, x*) when it
+/// accelerates at its start (x* > x_d exactly when the cruise speed is out of reach, and the
+/// peak is then A(x*) = (A_entry + A_exit + s d) / 2), and from x_d otherwise.
+uint32_t profile_x2_decel(const Profile& p);
 
 /// A at half-tick position x2 = 2 x (so that segment midpoints are exact):
 ///   A(x) = min(start(x), A_exit + s (d - x)), start(x) = A_entry +- s x clamped at A_cruise.
@@ -53,10 +52,10 @@ struct SqrtTracker {
     uint32_t r;      ///< floor(sqrt(A))
     uint32_t c;      ///< r^2
     uint32_t c_next; ///< (r + 1)^2
-    uint16_t steps;  ///< R changes since reset (for the docs' cost figures)
 
     void reset(uint32_t a);
-    /// Moves R to floor(sqrt(a)). Returns true when R changed.
+    /// Moves R to floor(sqrt(a)) one square at a time (a full square root after a jump).
+    /// Returns true when R changed.
     bool seek(uint32_t a);
 };
 

@@ -94,8 +94,10 @@ class StepGen {
     uint32_t remaining() const { return line_.dist[0] - cursor_.x1; }
     uint32_t length() const { return line_.dist[0]; }
 
-    /// Position after every run pushed so far, steps.
-    const int32_t* pushed_position() const { return pos_; }
+    /// Position after every run pushed so far, steps: the move's start plus the macro
+    /// position reached (the interrupt never counts steps; this is derived when asked).
+    void pushed_position(int32_t out[kAxes]) const;
+    /// Sets the position (power-up, after an abort); the current move is forgotten.
     void set_position(const int32_t steps[kAxes]);
     /// Forgets the current move (soft reset); the position is kept.
     void abort();
@@ -126,25 +128,18 @@ class StepGen {
     uint32_t a_of(uint32_t v2) const;
     void emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8);
 
-    const StepLengths* lengths_;
-    uint16_t min_period_;
+    // Most used first: the ATmega328P addresses the first 64 bytes of an object directly.
     bool active_;
     bool holding_;
     bool stopped_;
     bool have_handover_;
-    uint8_t seg_len_;
-    uint8_t decelerating_;
-
-    MoveSpec spec_;
-    LineGeometry line_;
-    LineCursor cursor_;
-    Profile prof_;
-    Num a_per_v2_;    ///< A per (mm/min)^2 at the profile's scale
-    uint32_t origin_; ///< reference tick where the profile starts (moves after a resume)
-    uint32_t x2_decel_;
-    SqrtTracker root_;
     bool root_valid_;
-    uint32_t delta_q8_;   ///< Delta_1 of the last segment, cycles x 256
+    uint8_t seg_len_;
+    uint8_t seen_head_;
+    uint16_t queued_;  ///< motion queued ahead of the interrupt, 1024-cycle units
+    uint16_t min_period_;
+    uint32_t origin_;     ///< reference tick where the profile starts (moves after a resume)
+    uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
     uint32_t a_last_;     ///< A of the last segment
     uint32_t delta_root_; ///< d_num / R for the current R
     uint32_t kmax_;       ///< largest K of the move
@@ -152,16 +147,20 @@ class StepGen {
     uint32_t a_hold_;
     uint32_t x2_hold_;
     uint32_t handover_v2_;
-
-    // Duration of each queued run in 1024-cycle units (saturated), by queue slot, and their
-    // sum: lets fill() keep the horizon without any help from the interrupt.
-    uint8_t slot_time_[kRunQueueSize];
-    uint16_t queued_;
-    uint8_t seen_head_;
-
+    Profile prof_;
+    SqrtTracker root_;
+    Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
+    // What remains needed of the MoveSpec after begin().
+    uint32_t len_q8_, accel_, feed_, v_nominal2_, v_exit2_;
+    const StepLengths* lengths_;
+    LineGeometry line_;
+    LineCursor cursor_;
+    int32_t start_[kAxes]; ///< position where the current (or last) move started, steps
     uint32_t k_[1u << (kAxes - 1)];
     uint8_t k_mask_[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
-    int32_t pos_[kAxes];
+    // Duration of each queued run in 1024-cycle units (saturated), by queue slot: keeps the
+    // horizon without any help from the interrupt.
+    uint8_t slot_time_[kRunQueueSize];
 };
 
 } // namespace ll
