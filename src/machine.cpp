@@ -5,15 +5,12 @@
 namespace ll {
 
 void machine_build(Machine& m, const Settings& s) {
+    m.settings = &s;
     uint32_t spm[kAxes];
     for (uint8_t a = 0; a < kAxes; ++a) {
         const AxisSettings& ax = s.axis[a];
         spm[a] = ax.steps_per_unit < 1000 ? 1000 : ax.steps_per_unit;
         m.um_q8_per_step[a].set(256000000ul).div(spm[a]);
-        m.max_rate[a] = ax.max_rate;
-        // mm/s^2 x1000 -> mm/min^2: x 3600 / 1000 = x 18 / 5
-        m.accel[a] = ax.accel > 0xFFFFFFFFul / 18 ? 0xFFFFFFFFul / 5 : ax.accel * 18 / 5;
-        if (m.accel[a] == 0) m.accel[a] = 1;
     }
     for (uint8_t a = 0; a < kAxes; ++a) {
         uint8_t mask = 0;

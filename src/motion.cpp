@@ -62,15 +62,19 @@ bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
 
 // The commanded position that matches a machine position in steps, mm x1000 (after an abort
 // the machine is between targets; the next move's direction is taken from here).
-const int32_t* position_um(Motion& m, const int32_t steps[kAxes]) {
-    static int32_t um[kAxes];
+void position_um(Motion& m, const int32_t steps[kAxes], int32_t um[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) {
         int32_t s = steps[a];
         uint32_t mag = s < 0 ? static_cast<uint32_t>(-(s + 1)) + 1u : static_cast<uint32_t>(s);
         int32_t v = static_cast<int32_t>(m.machine.um_q8_per_step[a].of(mag) >> 8);
         um[a] = s < 0 ? -v : v;
     }
-    return um;
+}
+
+void reset_planner(Motion& m, const int32_t here[kAxes]) {
+    int32_t um[kAxes];
+    position_um(m, here, um);
+    m.planner.reset(here, um);
 }
 
 void enable(Motion& m, bool on) {
@@ -182,7 +186,7 @@ bool abort() {
     g_exec.starved = 0;
     m.gen.abort();
     m.gen.set_position(here);
-    m.planner.reset(here, position_um(m, here));
+    reset_planner(m, here);
     m.begun = false;
     m.state = State::Idle;
     m.idle_since = hal::millis();
@@ -234,7 +238,7 @@ void settings_changed() {
     hal::stepper_configure(cfg);
     int32_t here[kAxes];
     position(here);
-    m.planner.reset(here, position_um(m, here));
+    reset_planner(m, here);
     if (g_settings.idle_delay_ms == 255) enable(m, true);
 }
 

@@ -7,19 +7,29 @@ uint32_t min32(uint32_t a, uint32_t b) {
     return a < b ? a : b;
 }
 
+// The per-axis limits, read straight from the settings: maximum rates (units/min x1000) and
+// accelerations (units/s^2 x1000, which scale to units/min^2 by x3.6).
+enum Limit : uint8_t { kRate = 0, kAccel = 1 };
+uint32_t axis_limit(const Settings& s, uint8_t a, Limit which) {
+    return which == kRate ? s.axis[a].max_rate : s.axis[a].accel;
+}
+
 // min over axes with comp[a] > 0 of lim[a] / comp[a], times `scale`: the largest value along a
 // direction that keeps every axis within its own limit (GRBL's limit_value_by_axis_maximum).
-uint32_t limit_along(const uint32_t lim[kAxes], const uint32_t comp[kAxes], const Num& scale) {
+uint32_t limit_along(const Settings& s, Limit which, const uint32_t comp[kAxes], Num scale) {
     Num best{};
     bool any = false;
     for (uint8_t a = 0; a < kAxes; ++a) {
         if (comp[a] == 0) continue;
-        Num v(lim[a]);
+        Num v(axis_limit(s, a, which));
         v.div(comp[a]);
         if (!any || v.cmp(best) < 0) best = v;
         any = true;
     }
-    return any ? best.mul(scale).u32() : 0xFFFFFFFFul;
+    if (!any) return 0xFFFFFFFFul;
+    if (which == kAccel) scale.mul(Num(18)).div(5); // units/s^2 x1000 -> units/min^2
+    uint32_t v = best.mul(scale).u32();
+    return v ? v : 1;
 }
 
 // Euclidean norm of kAxes 32-bit components.
@@ -45,9 +55,8 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
     out.len_q8 = norm(xg).u32();
     if (out.len_q8 == 0) out.len_q8 = 1;
     Num len(out.len_q8);
-    out.vmax = limit_along(m.max_rate, x, len);
-    out.accel = limit_along(m.accel, x, len);
-    if (out.accel == 0) out.accel = 1;
+    out.vmax = limit_along(*m.settings, kRate, x, len);
+    out.accel = limit_along(*m.settings, kAccel, x, len);
 }
 
 int32_t Planner::delta(const PlanBlock& b, uint8_t axis) {
@@ -98,7 +107,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes]) const {
     Num p = sin_half;
     if (p.mul(sin_half).cmp(eps) <= 0) return 0;
     // Acceleration along the junction vector d, limited per axis; delta in µm / 1000.
-    uint32_t ja = limit_along(m_->accel, dc, dn);
+    uint32_t ja = limit_along(*m_->settings, kAccel, dc, dn);
     Num r(1);
     r.add(sin_half).mul(sin_half).div(q).mul(ja).mul(m_->junction_dev_um).div(1000);
     return r.u32();

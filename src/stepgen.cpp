@@ -67,14 +67,22 @@ void StepGen::build_k_table(uint8_t group) {
         }
         k_mask_[sub] = mask;
     }
-    // Average regulated step length of the line's tick path, over the runs of the §8 order
-    // (all axes, then all but the shortest, ...): run i has the axes of sorted positions 0..i
-    // and lasts dist[i] - dist[i+1] micro steps.
+    // Feed along the line (docs/motion.md): a line of d_1 micro steps takes len / V, so the
+    // micro steps share that time in proportion to their regulated lengths L_P. Over the runs
+    // of the §8 order (run i has the axes of sorted positions 0..i and lasts dist[i] -
+    // dist[i+1] micro steps), the regulated steps sum to sum_g over count_g steps. Runs where no
+    // regulated axis steps (seed §3.1: the other groups follow) take the mean regulated step
+    // time, so the followers move at their average rate rather than in bursts. Altogether
+    //   K[P] = L_P * count_g / sum_g  (Q20), and 1 for a run without a regulated axis.
+    uint32_t lens[1u << (kAxes - 1)];
+    for (uint8_t sub = 0; sub < sets; ++sub) {
+        lens[sub] = step_length(*lengths_, static_cast<uint8_t>(k_mask_[sub] & group));
+    }
     Num sum_g{};
     uint32_t count_g = 0;
     for (uint8_t i = 0; i < m; ++i) {
         uint32_t n = line_.dist[i] - (i + 1 < m ? line_.dist[i + 1] : 0);
-        uint32_t len = lengths_->len[k_mask_[(1u << i) - 1] & group];
+        uint32_t len = lens[(1u << i) - 1];
         if (len != 0) {
             sum_g.add(Num(n).mul(len));
             count_g += n;
@@ -85,23 +93,11 @@ void StepGen::build_k_table(uint8_t group) {
         build_k_table(0xFF);
         return;
     }
-    // Runs where no regulated axis steps (seed §3.1: the other groups follow) take the mean
-    // regulated step time, so the followers move at their average rate rather than in bursts.
-    uint32_t mean_g = sum_g.div(count_g).u32();
-    Num stair{};
-    for (uint8_t i = 0; i < m; ++i) {
-        uint32_t n = line_.dist[i] - (i + 1 < m ? line_.dist[i + 1] : 0);
-        uint32_t len = lengths_->len[k_mask_[(1u << i) - 1] & group];
-        stair.add(Num(n).mul(len != 0 ? len : mean_g));
-    }
-    // K_P normalised so that the whole line takes len / V (docs/motion.md, "Feed along the
-    // line"): K[P] = L_P * d_1 / stair, Q20.
-    Num r(line_.dist[0], 20);
-    r.div(stair);
+    Num r(count_g, 20);
+    r.div(sum_g);
     kmax_ = 0;
     for (uint8_t sub = 0; sub < sets; ++sub) {
-        uint32_t len = lengths_->len[k_mask_[sub] & group];
-        k_[sub] = r.of(len != 0 ? len : mean_g);
+        k_[sub] = lens[sub] != 0 ? r.of(lens[sub]) : 1ul << 20;
         if (k_[sub] > kmax_) kmax_ = k_[sub];
     }
 }

@@ -5,19 +5,20 @@
 namespace ll {
 
 void step_lengths_build(StepLengths& t, const uint32_t steps_per_unit_milli[kAxes]) {
-    Num inv2[kAxes]; // (1/T_a)^2, mm^2
     for (uint8_t a = 0; a < kAxes; ++a) {
         uint32_t tm = steps_per_unit_milli[a] < 1000 ? 1000 : steps_per_unit_milli[a];
-        inv2[a].set(1000).div(tm);
-        inv2[a].mul(inv2[a]);
+        Num& v = t.inv2[a];
+        v.set(1000).div(tm);
+        v.mul(v);
     }
-    for (uint8_t s = 0; s < (1u << kAxes); ++s) {
-        Num sum{};
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            if (s & (1u << a)) sum.add(inv2[a]);
-        }
-        t.len[s] = sum.sqrt().shift(30).u32(); // Q30
+}
+
+uint32_t step_length(const StepLengths& t, uint8_t set) {
+    Num sum{};
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        if (set & (1u << a)) sum.add(t.inv2[a]);
     }
+    return sum.sqrt().shift(30).u32(); // Q30
 }
 
 uint32_t wait_q8(const StepLengths& t, uint8_t set, uint8_t group, uint32_t speed) {
@@ -25,7 +26,8 @@ uint32_t wait_q8(const StepLengths& t, uint8_t set, uint8_t group, uint32_t spee
     // cycles x 256 = len * 2^-30 * 60 * kCpuHz * 1000 * 256 / speed
     //              = len * 937500000 * 2^10 / (speed * 2^22)
     static_assert(60ull * kCpuHz * 1000 == 937500000ull << 10, "units");
-    return Num(937500000).div(speed).shift(-12).of(t.len[set & group]);
+    return Num(937500000).div(speed).shift(-12).of(
+        step_length(t, static_cast<uint8_t>(set & group)));
 }
 
 } // namespace ll

@@ -11,9 +11,8 @@ namespace ll {
 
 struct Machine {
     StepLengths lengths;
+    const Settings* settings;  ///< rates and accelerations are read from here directly
     Num um_q8_per_step[kAxes]; ///< µm x 256 travelled per step (1 / T_a)
-    uint32_t max_rate[kAxes];  ///< units/min x1000
-    uint32_t accel[kAxes];     ///< units/min^2
     uint8_t group_of[kAxes];   ///< axis bits sharing axis a's speed group
     uint32_t junction_dev_um;  ///< $11, µm
     uint16_t min_period;       ///< shortest step period the interrupt honours, CPU cycles

@@ -136,7 +136,7 @@ class StepGen {
     bool root_valid_;
     uint8_t seg_len_;
     uint8_t seen_head_;
-    uint16_t queued_;  ///< motion queued ahead of the interrupt, 1024-cycle units
+    uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
     uint16_t min_period_;
     uint32_t origin_;     ///< reference tick where the profile starts (moves after a resume)
     uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_

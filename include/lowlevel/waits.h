@@ -9,18 +9,23 @@
 #pragma once
 
 #include "lowlevel/config.h"
+#include "lowlevel/fixmath.h"
 
 namespace ll {
 
-/// Regulated length of one micro step on each axis set S (bit a = machine axis a):
-/// len[S] = sqrt(sum_{j in S} 1/T_j^2) mm, as a Q30 fixed-point value (mm x 2^30).
-/// The regulated group G is applied by indexing with (S & G). Requires T_j >= 1 step/mm.
+/// Regulated length of micro steps (seed §3.2): sqrt(sum_{j in S} 1/T_j^2) mm for an axis set S
+/// (bit a = machine axis a). Kept per axis as 1/T_a^2 (a table over every axis set would cost
+/// 2^N x 4 bytes of RAM); the regulated group G is applied by asking for S & G.
 struct StepLengths {
-    uint32_t len[1u << kAxes];
+    Num inv2[kAxes]; ///< 1/T_a^2, mm^2 per step^2
 };
 
-/// Builds the table from the steps per unit of each axis (x1000, as in Settings).
+/// Builds the table from the steps per unit of each axis (x1000, as in Settings). Requires
+/// T_a >= 1 step per unit.
 void step_lengths_build(StepLengths& t, const uint32_t steps_per_unit_milli[kAxes]);
+
+/// Length of one micro step on the axis set `set`, mm x 2^30 (Q30): below 4 mm for T >= 1.
+uint32_t step_length(const StepLengths& t, uint8_t set);
 
 /// Delta_P of §3.2 in CPU cycles x 256 for the axis set `set` restricted to `group`, at a
 /// regulated speed of `speed` units/min x1000. Used where a single wait is needed outside a
