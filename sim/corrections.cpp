@@ -42,6 +42,7 @@ const Field kFields[] = {
     {"irq_response_cycles", &Corrections::irq_response_cycles},
     {"irq_one_instruction_after_sei", &Corrections::irq_one_instruction_after_sei},
     {"sbi_cbi_single_bit", &Corrections::sbi_cbi_single_bit},
+    {"timer_flags_write_one_to_clear", &Corrections::timer_flags_write_one_to_clear},
     {"no_wallclock_sleep", &Corrections::no_wallclock_sleep},
 };
 
@@ -96,7 +97,10 @@ Corrector::Corrector(avr_t* avr, IoHooks& hooks, const Corrections& c)
     if (extint_) install_extint(extint_);
     for (char n : {'B', 'C', 'D'})
         if (avr_ioport_t* p = find_module<avr_ioport_t>(avr_, "port", n)) install_sbi_cbi(p->r_pin);
-    for (auto& f : timers_) install_sbi_cbi(f->t->overflow.raised.reg); // TIFRn
+    for (auto& f : timers_) {
+        install_sbi_cbi(f->t->overflow.raised.reg); // TIFRn; runs before the flag-clear hook
+        install_flag_clear(f->t);
+    }
     after_reset();
 }
 
@@ -104,6 +108,7 @@ void Corrector::after_reset() {
     // avr_reset() emptied the cycle-timer pool, our ticks included.
     for (auto& f : timers_) f->top_zero_active = false;
     slept_ = false;
+    extint_armed_[0] = extint_armed_[1] = false;
     if (uart0_) {
         // The harness reads UART output itself; simavr's STDIO flag would also print every line.
         uint32_t flags = uart0_->flags & ~static_cast<uint32_t>(AVR_UART_FLAG_STDIO);
@@ -115,6 +120,13 @@ void Corrector::after_reset() {
 }
 
 // ---- interrupts ---------------------------------------------------------------------------
+
+void Corrector::on_sleep() {
+    slept_ = true;
+    // simavr's run loop advances a sleeping CPU by 1 + (cycles to the next cycle timer), so the
+    // CPU wakes one cycle after the event; take that cycle back before it is added.
+    if (c_.irq_response_cycles && avr_->cycle > 0) avr_->cycle -= 1;
+}
 
 void Corrector::on_irq_entry() {
     if (c_.irq_response_cycles)
@@ -343,26 +355,73 @@ void Corrector::update_frame_time() {
 // ---- external interrupts (SIMAVR-NOTES 7) -------------------------------------------------
 
 void Corrector::install_extint(avr_extint_t* e) {
-    const uint16_t eimsk = e->eint[0].vector.enable.reg;
-    if (!eimsk) return;
-    hooks_.on_write(eimsk, [this](uint16_t, uint8_t v, const IoHooks::WriteNext& next) {
-        next(v);
-        update_extint_polling();
-    });
+    // EIMSK enables INTn, EICRA selects its sense; both decide whether the level poll is needed.
+    std::vector<uint16_t> regs = {static_cast<uint16_t>(e->eint[0].vector.enable.reg),
+                                  static_cast<uint16_t>(e->eint[0].isc[0].reg)};
+    std::sort(regs.begin(), regs.end());
+    regs.erase(std::unique(regs.begin(), regs.end()), regs.end());
+    for (uint16_t reg : regs) {
+        if (!reg) continue;
+        hooks_.on_write(reg, [this](uint16_t, uint8_t v, const IoHooks::WriteNext& next) {
+            next(v);
+            update_extint_polling();
+        });
+    }
 }
 
 void Corrector::update_extint_polling() {
     if (!extint_) return;
     for (uint8_t i = 0; i < 2; ++i) {
-        if (!extint_->eint[i].port_ioctl) continue;
-        // Polling a low INTn pin every cycle is the datasheet's level interrupt: needed only
-        // while the firmware has that interrupt enabled.
-        const bool enabled = avr_regbit_get(avr_, extint_->eint[i].vector.enable) != 0;
+        auto& eint = extint_->eint[i];
+        if (!eint.port_ioctl) continue;
+        const bool enabled = avr_regbit_get(avr_, eint.vector.enable) != 0;
+        // Polling a low INTn pin every cycle is how simavr makes a low-level interrupt repeat, as
+        // the datasheet requires (13.1): needed only while the firmware has INTn enabled.
         avr_extint_set_strict_lvl_trig(avr_, i, (!c_.extint_idle_poll_off || enabled) ? 1 : 0);
+        if (!c_.extint_idle_poll_off) continue;
+        avr_regbit_t isc[2] = {eint.isc[0], eint.isc[1]};
+        const bool armed = enabled && avr_regbit_get_array(avr_, isc, 2) == 0;
+        if (armed && !extint_armed_[i]) {
+            // simavr starts its poll only on a falling edge of the pin; stock simavr had it
+            // running since the pin went low. Start it now if the pin is low already.
+            avr_ioport_state_t st;
+            const char port = static_cast<char>(eint.port_ioctl & 0xFF);
+            if (avr_ioctl(avr_, AVR_IOCTL_IOPORT_GETSTATE(port), &st) >= 0) {
+                const unsigned ddr = st.ddr, out = st.port, pin = st.pin;
+                const unsigned level =
+                    ((ddr >> eint.port_pin) & 1) ? (out >> eint.port_pin) : (pin >> eint.port_pin);
+                if (!(level & 1)) avr_raise_irq(extint_->io.irq + i, 0);
+            }
+        }
+        extint_armed_[i] = armed;
     }
 }
 
-// ---- SBI / CBI (found here) ---------------------------------------------------------------
+// ---- SBI / CBI and timer flags (found here) ------------------------------------------------
+
+void Corrector::install_flag_clear(avr_timer_t* t) {
+    const uint16_t tifr = static_cast<uint16_t>(t->overflow.raised.reg);
+    if (!tifr) return;
+    hooks_.on_write(tifr, [this, t](uint16_t a, uint8_t v, const IoHooks::WriteNext& next) {
+        if (!c_.timer_flags_write_one_to_clear) {
+            next(v);
+            return;
+        }
+        avr_int_vector_t* vectors[] = {&t->overflow, &t->icr, &t->comp[0].interrupt,
+                                       &t->comp[1].interrupt, &t->comp[2].interrupt};
+        bool was_set[5];
+        for (int i = 0; i < 5; ++i)
+            was_set[i] = vectors[i]->raised.reg == a && avr_regbit_get(avr_, vectors[i]->raised);
+        next(v);
+        // Raise again what simavr cleared although its bit was written as zero.
+        for (int i = 0; i < 5; ++i) {
+            avr_int_vector_t* vec = vectors[i];
+            if (was_set[i] && !avr_regbit_from_value(avr_, vec->raised, v) &&
+                !avr_regbit_get(avr_, vec->raised))
+                avr_raise_interrupt(avr_, vec);
+        }
+    });
+}
 
 void Corrector::install_sbi_cbi(uint16_t addr) {
     if (!addr) return;

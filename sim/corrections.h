@@ -44,7 +44,8 @@ struct Corrections {
     /// low) only while the firmware has enabled that interrupt (wall time only).
     bool extint_idle_poll_off = true;
     /// Found here: the interrupt response takes 4 cycles (datasheet 6.7 "Reset and Interrupt
-    /// Handling"), 8 when it wakes the CPU from sleep; simavr 1.6 charges 0.
+    /// Handling"), 8 when it wakes the CPU from sleep; simavr 1.6 charges 0, and wakes a sleeping
+    /// CPU one cycle after the event that wakes it.
     bool irq_response_cycles = true;
     /// Found here: after SEI or RETI exactly one instruction runs before a pending interrupt is
     /// served (datasheet 6.7); simavr 1.6 runs two.
@@ -53,6 +54,10 @@ struct Corrections {
     /// / 14.2.2); simavr 1.6 does a read-modify-write of the whole register, which toggles every
     /// other pin that reads high (PINx) or clears every other pending flag (TIFRn).
     bool sbi_cbi_single_bit = true;
+    /// Found here: writing TIFRn clears exactly the flags written as one (datasheet 15.11.9 "OCF1A
+    /// is cleared by writing a logic one to its bit location"); simavr 1.6 clears every pending
+    /// flag of the register on any write, so `TIFR1 = 1 << OCF1A` also drops a pending OCF1B.
+    bool timer_flags_write_one_to_clear = true;
     /// Not a datasheet item: the SLEEP instruction must not make the host usleep() for the
     /// simulated sleep time (simavr's raw run loop does). Wall time only.
     bool no_wallclock_sleep = true;
@@ -81,8 +86,8 @@ class Corrector {
 
     /// Called when the CPU accepts an interrupt (simavr raised the vector's RUNNING IRQ).
     void on_irq_entry();
-    /// Called each time simavr's run loop puts the CPU to sleep for a while.
-    void on_sleep() { slept_ = true; }
+    /// Called each time simavr's run loop lets a sleeping CPU skip to the next cycle timer.
+    void on_sleep();
     /// Called after every instruction step of the run loop.
     void after_step() {
         // simavr sets interrupt_state = -2 on SEI/RETI and counts it up once per step; -1 right
@@ -107,6 +112,7 @@ class Corrector {
     void install_uart(avr_uart_t* u);
     void install_extint(avr_extint_t* e);
     void install_sbi_cbi(uint16_t addr);
+    void install_flag_clear(avr_timer_t* t);
 
     uint32_t prescaler(const avr_timer_t* t) const; ///< CPU cycles per tick; 0 = stopped/external
     uint16_t count(const avr_timer_t* t) const;     ///< TCNTn as stored in the data space
@@ -125,6 +131,7 @@ class Corrector {
     std::vector<std::unique_ptr<TimerFix>> timers_; ///< stable addresses: cycle-timer params
     avr_uart_t* uart0_ = nullptr;
     avr_extint_t* extint_ = nullptr;
+    bool extint_armed_[2] = {false, false}; ///< INTn enabled in low-level mode
     bool slept_ = false;
 };
 

@@ -310,15 +310,17 @@ void Sim::arm_host_timer(uint64_t at) {
     host_armed_at_ = std::max(at, now);
 }
 
-avr_cycle_count_t Sim::host_timer_cb(avr_t* avr, avr_cycle_count_t, void* param) {
+avr_cycle_count_t Sim::host_timer_cb(avr_t* avr, avr_cycle_count_t when, void* param) {
     Sim* self = static_cast<Sim*>(param);
-    const uint64_t next = self->host_service(avr->cycle);
+    const uint64_t next = self->host_service(when, avr->cycle);
     self->host_armed_ = next != 0;
     self->host_armed_at_ = next;
     return next;
 }
 
-uint64_t Sim::host_service(uint64_t now) {
+// `when` is the cycle this service was scheduled for; `now` >= when is the end of the instruction
+// after which simavr ran it.
+uint64_t Sim::host_service(uint64_t when, uint64_t now) {
     // 1. Bytes whose time has come join the wire queue, in time order.
     while (!scheduled_.empty() && scheduled_.begin()->first <= now) {
         const auto it = scheduled_.begin();
@@ -339,12 +341,14 @@ uint64_t Sim::host_service(uint64_t now) {
     uint64_t next = kNever;
     if (line_head_ < line_.size()) {
         const HostByte& b = line_[line_head_];
-        const uint64_t start = std::max(b.not_before, wire_free_at_);
-        if (start > now) {
-            next = start;
+        const uint64_t ideal = std::max(b.not_before, wire_free_at_);
+        if (ideal > now) {
+            next = ideal;
         } else if (!receiver_ready()) {
             next = now + kBlockedRetryCycles;
         } else {
+            // A byte held back (receiver off, XOFF) starts when it is let through.
+            const uint64_t start = std::max(ideal, when);
             const unsigned fill = (uart_->input.write + uart_fifo_fifo_size - uart_->input.read) &
                                   (uart_fifo_fifo_size - 1);
             // Three unread bytes: the third found the hardware's 2-byte FIFO full (DOR).

@@ -204,7 +204,7 @@ class Sim {
     template <class Done>
     bool run_loop(uint64_t limit, Done done);
     void arm_host_timer(uint64_t at);
-    uint64_t host_service(uint64_t now);
+    uint64_t host_service(uint64_t when, uint64_t now);
     bool receiver_ready() const;
     void on_output(uint8_t byte);
     void on_vector(uint8_t vector, uint32_t running);

@@ -4,8 +4,14 @@
  *
  * Transmit: the UDRE interrupt sends "0123456789" back to back; in steady state one byte leaves
  * every frame. Receive: each byte received toggles step_y in the RX interrupt; bytes sent back to
- * back by the host arrive one frame apart. */
+ * back by the host arrive one frame apart.
+ *
+ * Between interrupts the CPU sleeps in idle mode: an interrupt then always finds the CPU in the
+ * same state (no instruction to finish), so the cycles between two ISRs are exactly the cycles
+ * between their flags. A busy loop (RJMP, 2 cycles) would add a cycle of jitter. */
 #include "selftest.h"
+
+#include <avr/sleep.h>
 
 static const char message[] = "0123456789";
 static volatile uint8_t next_index;
@@ -31,6 +37,8 @@ int main(void) {
     UBRR0H = 0;
     UBRR0L = 16;
     UCSR0B = (1 << RXEN0) | (1 << TXEN0) | (1 << RXCIE0) | (1 << UDRIE0);
+    set_sleep_mode(SLEEP_MODE_IDLE);
+    sleep_enable();
     sei();
-    idle_forever();
+    for (;;) sleep_cpu();
 }
