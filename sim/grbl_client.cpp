@@ -35,7 +35,7 @@ std::vector<OutputLine> Grbl::take_acks() {
 }
 
 bool Grbl::wait_banner(uint64_t max_cycles) {
-    const uint64_t limit = sim_.cycle() + max_cycles;
+    const uint64_t limit = sim_.deadline(max_cycles);
     for (;;) {
         const std::vector<OutputLine>& all = sim_.output_lines();
         for (; cursor_ < all.size(); ++cursor_) {
@@ -65,7 +65,7 @@ std::vector<Reply> Grbl::stream(const std::vector<std::string>& lines, uint64_t 
     size_t used = 0, next = 0, done = 0;
     max_in_flight_ = 0;
     take_acks(); // answers to earlier traffic are not ours
-    const uint64_t limit = sim_.cycle() + max_cycles;
+    const uint64_t limit = sim_.deadline(max_cycles);
     while (done < lines.size()) {
         while (next < lines.size() && used + lines[next].size() + 1 <= rx_buffer) {
             const size_t bytes = lines[next].size() + 1;
@@ -104,7 +104,7 @@ std::vector<Reply> Grbl::stream(const std::vector<std::string>& lines, uint64_t 
 std::string Grbl::status(uint64_t max_cycles) {
     const size_t seen = others_.size();
     sim_.send("?");
-    const uint64_t limit = sim_.cycle() + max_cycles;
+    const uint64_t limit = sim_.deadline(max_cycles);
     for (;;) {
         take_acks();
         for (size_t i = seen; i < others_.size(); ++i)

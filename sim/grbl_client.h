@@ -46,6 +46,9 @@ class Grbl {
     /// Sends '?' and runs until the next "<...>" status report; "" on timeout.
     std::string status(uint64_t max_cycles);
 
+    /// Takes in the output lines received so far (acknowledgements nobody waits for are dropped).
+    void collect() { take_acks(); }
+
     /// Largest number of unanswered bytes in flight during the last stream().
     size_t max_in_flight() const { return max_in_flight_; }
     /// Output lines that were not acknowledgements (status reports, messages, banner...), with

@@ -158,17 +158,17 @@ void Sim::run_until_cycle(uint64_t c) {
 
 bool Sim::run_until(const std::function<bool()>& done, uint64_t max_cycles) {
     if (done()) return true;
-    return run_loop(avr_->cycle + max_cycles, [&] { return done(); });
+    return run_loop(deadline(max_cycles), [&] { return done(); });
 }
 
 bool Sim::run_until_any_output(uint64_t max_cycles) {
     const size_t n = out_bytes_.size();
-    return run_loop(avr_->cycle + max_cycles, [&] { return out_bytes_.size() != n; });
+    return run_loop(deadline(max_cycles), [&] { return out_bytes_.size() != n; });
 }
 
 bool Sim::run_until_output(const std::string& text, uint64_t max_cycles) {
     const size_t from = out_text_.size();
-    const uint64_t limit = avr_->cycle + max_cycles;
+    const uint64_t limit = deadline(max_cycles);
     while (avr_->cycle < limit) {
         if (!run_until_any_output(limit - avr_->cycle)) return false;
         if (out_text_.find(text, from) != std::string::npos) return true;
@@ -177,7 +177,7 @@ bool Sim::run_until_output(const std::string& text, uint64_t max_cycles) {
 }
 
 bool Sim::run_until_pc(uint32_t byte_address, uint64_t max_cycles) {
-    return run_loop(avr_->cycle + max_cycles, [&] { return avr_->pc == byte_address; });
+    return run_loop(deadline(max_cycles), [&] { return avr_->pc == byte_address; });
 }
 
 avr_cycle_count_t Sim::limit_timer_cb(avr_t*, avr_cycle_count_t, void*) {
@@ -295,11 +295,14 @@ uint64_t Sim::frame_cycles() const {
     return uart_ ? uart_->cycles_per_byte : 0;
 }
 
+unsigned Sim::receiver_fill() const {
+    return (uart_->input.write + uart_fifo_fifo_size - uart_->input.read) &
+           (uart_fifo_fifo_size - 1);
+}
+
 bool Sim::receiver_ready() const {
     if (!uart_ || xoff_ || !avr_regbit_get(avr_, uart_->rxen)) return false;
-    const unsigned fill =
-        (uart_->input.write + uart_fifo_fifo_size - uart_->input.read) & (uart_fifo_fifo_size - 1);
-    return fill + 1 < uart_fifo_fifo_size;
+    return receiver_fill() + 1 < uart_fifo_fifo_size;
 }
 
 void Sim::arm_host_timer(uint64_t at) {
@@ -321,6 +324,20 @@ avr_cycle_count_t Sim::host_timer_cb(avr_t* avr, avr_cycle_count_t when, void* p
 // `when` is the cycle this service was scheduled for; `now` >= when is the end of the instruction
 // after which simavr ran it.
 uint64_t Sim::host_service(uint64_t when, uint64_t now) {
+    // 0. Stop bits that have arrived: on hardware the byte is lost when the receive FIFO (2 bytes)
+    //    is still full of unread ones. simavr's queue holds the arrived bytes and the ones still
+    //    on the wire, which are exactly those with a later arrival.
+    while (arrivals_head_ < arrivals_.size() && arrivals_[arrivals_head_] <= now) {
+        ++arrivals_head_;
+        const unsigned on_wire = static_cast<unsigned>(arrivals_.size() - arrivals_head_);
+        const unsigned fill = receiver_fill();
+        if (fill > on_wire && fill - on_wire > 2) ++overruns_;
+    }
+    if (arrivals_head_ == arrivals_.size()) {
+        arrivals_.clear();
+        arrivals_head_ = 0;
+    }
+
     // 1. Bytes whose time has come join the wire queue, in time order.
     while (!scheduled_.empty() && scheduled_.begin()->first <= now) {
         const auto it = scheduled_.begin();
@@ -349,14 +366,11 @@ uint64_t Sim::host_service(uint64_t when, uint64_t now) {
         } else {
             // A byte held back (receiver off, XOFF) starts when it is let through.
             const uint64_t start = std::max(ideal, when);
-            const unsigned fill = (uart_->input.write + uart_fifo_fifo_size - uart_->input.read) &
-                                  (uart_fifo_fifo_size - 1);
-            // Three unread bytes: the third found the hardware's 2-byte FIFO full (DOR).
-            if (fill >= 3) ++overruns_;
             // simavr delivers it one frame after this call (its RX pump), i.e. at start + frame.
             avr_raise_irq(uart_in_, b.byte);
             in_bytes_.push_back(SerialByte{start, b.byte});
             wire_free_at_ = start + uart_->cycles_per_byte;
+            arrivals_.push_back(wire_free_at_);
             ++line_head_;
             if (line_head_ == line_.size()) {
                 line_.clear();
@@ -368,6 +382,7 @@ uint64_t Sim::host_service(uint64_t when, uint64_t now) {
     }
     if (!scheduled_.empty()) next = std::min<uint64_t>(next, scheduled_.begin()->first);
     for (const Periodic& p : periodic_) next = std::min(next, p.next);
+    if (arrivals_head_ < arrivals_.size()) next = std::min(next, arrivals_[arrivals_head_]);
     if (next == kNever) return 0;
     return std::max(next, now + 1);
 }
@@ -510,8 +525,21 @@ void Sim::reset() {
     corr_->after_reset();
     host_armed_ = false;
     xoff_ = false;
+    arrivals_.clear(); // simavr's reset empties its receive queue
+    arrivals_head_ = 0;
     isr_open_.clear();
-    // SIMAVR-NOTES 8: after a reset the PINx registers read 0 until the pins are raised again.
+    // SIMAVR-NOTES 8: avr_reset() zeroes PINx but leaves each pin IRQ at its old level, so when
+    // the firmware enables a pull-up again simavr sees "no change" and PINx keeps reading 0 (a
+    // closed switch). Put every pin back to its reset level (tri-stated, reads 0), then re-drive
+    // the inputs the harness holds.
+    for (char port : {'B', 'C', 'D'}) {
+        for (uint8_t bit = 0; bit < 8; ++bit) {
+            const bool driven = std::any_of(inputs_.begin(), inputs_.end(), [&](const Input& in) {
+                return in.port == port && in.bit == bit;
+            });
+            if (!driven) avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ(port), bit), 0);
+        }
+    }
     for (const Input& in : inputs_) apply_input(in.port, in.bit, in.level);
     rec_->resync();
     ++resets_;

@@ -96,6 +96,10 @@ class Sim {
     // Runs stop at instruction boundaries: at the first one at or after the requested cycle.
 
     uint64_t cycle() const { return avr_->cycle; }
+    /// cycle() + cycles, saturating at kNever (so kNever means "no limit").
+    uint64_t deadline(uint64_t cycles) const {
+        return cycles >= kNever - avr_->cycle ? kNever : avr_->cycle + cycles;
+    }
     static double to_us(uint64_t cycles) { return cycles * 1e6 / kCpuHz; }
 
     void run_for(uint64_t cycles);
@@ -126,8 +130,9 @@ class Sim {
     size_t serial_pending() const;
     /// The UART0 frame time in cycles that simavr uses now (1360 at 115200 8N1 U2X, corrected).
     uint64_t frame_cycles() const;
-    /// Bytes the hardware would certainly have lost (receive FIFO of 2 full when the next stop bit
-    /// arrived): simavr itself never loses one (SIMAVR-NOTES 4).
+    /// Bytes the hardware would have lost: their stop bit arrived while the 2-byte receive FIFO
+    /// held two unread bytes (data overrun, DOR0). simavr itself queues 64 and never loses one
+    /// (SIMAVR-NOTES 4), so a firmware reading too slowly shows up here.
     uint32_t overruns() const { return overruns_; }
 
     /// Every byte the firmware transmitted so far, with its cycle.
@@ -206,6 +211,7 @@ class Sim {
     void arm_host_timer(uint64_t at);
     uint64_t host_service(uint64_t when, uint64_t now);
     bool receiver_ready() const;
+    unsigned receiver_fill() const; ///< bytes in simavr's receive queue
     void on_output(uint8_t byte);
     void on_vector(uint8_t vector, uint32_t running);
     void apply_input(char port, uint8_t bit, bool level);
@@ -261,6 +267,8 @@ class Sim {
     uint64_t host_armed_at_ = 0;
     bool xoff_ = false;
     uint32_t overruns_ = 0;
+    std::vector<uint64_t> arrivals_; ///< stop-bit cycles of bytes given to simavr, not yet due
+    size_t arrivals_head_ = 0;
     std::vector<SerialByte> in_bytes_;
 
     // serial line, firmware -> host
