@@ -183,14 +183,9 @@ void Corrector::install_timer(avr_timer_t* t) {
         hooks_.on_write(addr, [this, f](uint16_t, uint8_t v, const IoHooks::WriteNext& next) {
             avr_timer_t* tm = f->t;
             const bool was_running = prescaler(tm) != 0;
-            uint16_t before = count(tm);
-            if (was_running) {
-                if (f->top_zero_active)
-                    before = 0; // TOP = 0: the counter is cleared on every tick
-                else
-                    (void)hooks_.read_original(tm->r_tcnt), before = count(tm); // live count
-            }
+            const uint16_t before = live_count(*f); // the held value when stopped
             next(v);
+            cancel_run_up(*f); // simavr re-planned this timer's compares
             if (c_.timer_keeps_count) {
                 const bool running = prescaler(tm) != 0;
                 if (was_running && !running) {
@@ -211,6 +206,7 @@ void Corrector::install_timer(avr_timer_t* t) {
     // TCNTn: simavr reacts on the low byte (the high byte goes through TEMP first on hardware).
     hooks_.on_write(t->r_tcnt, [this, f](uint16_t, uint8_t v, const IoHooks::WriteNext& next) {
         next(v);
+        cancel_run_up(*f);
         avr_timer_t* tm = f->t;
         // simavr rescales the written value by tov_cycles / TOP, which is off by up to one
         // timer period; the datasheet counter simply continues from the written value.
@@ -221,21 +217,77 @@ void Corrector::install_timer(avr_timer_t* t) {
         avr_timer_t* tm = f->t;
         if (c_.timer_keeps_count && prescaler(tm) == 0)
             return avr_->data[tm->r_tcnt]; // frozen / preloaded value (simavr would answer 0)
-        if (f->top_zero_active) {
-            if (tm->r_tcnth) avr_->data[tm->r_tcnth] = 0;
-            return 0;
+        if (f->top_zero_active || (c_.timer_keeps_count && tm->tov_base > avr_->cycle)) {
+            const uint16_t v = live_count(*f);
+            if (tm->r_tcnth) avr_->data[tm->r_tcnth] = static_cast<uint8_t>(v >> 8);
+            return static_cast<uint8_t>(v);
         }
         return next();
     });
 
-    // OCRnA is TOP in CTC mode: writing it may enter or leave the OCRnA = 0 case (item 1).
+    // OCRnA is TOP in CTC mode: writing it may enter or leave the OCRnA = 0 case (item 1), or
+    // drop TOP below the count (item 2).
+    for (int i = AVR_TIMER_COMPB; i < AVR_TIMER_COMP_COUNT; ++i) f->run_up[i] = RunUp{f, i};
     if (t->comp[AVR_TIMER_COMPA].r_ocr) {
-        hooks_.on_write(t->comp[AVR_TIMER_COMPA].r_ocr,
-                        [this, f](uint16_t, uint8_t v, const IoHooks::WriteNext& next) {
-                            next(v);
-                            update_top_zero(*f);
-                        });
+        hooks_.on_write(t->comp[AVR_TIMER_COMPA].r_ocr, [this, f](uint16_t, uint8_t v,
+                                                                  const IoHooks::WriteNext& next) {
+            avr_timer_t* tm = f->t;
+            const avr_timer_wgm_t m = mode(tm);
+            const bool live = c_.timer_keeps_count && prescaler(tm) != 0 && tm->tov_cycles > 1 &&
+                              m.kind == avr_timer_wgm_ctc && m.top == avr_timer_wgm_reg_ocra;
+            const uint16_t before = live ? live_count(*f) : 0;
+            next(v);
+            update_top_zero(*f);
+            if (live && !f->top_zero_active && tm->tov_cycles > 1 &&
+                before > ocr(tm, AVR_TIMER_COMPA))
+                top_below_count(*f, before);
+        });
     }
+}
+
+uint16_t Corrector::live_count(TimerFix& f) {
+    avr_timer_t* t = f.t;
+    const uint32_t presc = prescaler(t);
+    if (presc == 0) return count(t);
+    if (f.top_zero_active) return 0; // TOP = 0: cleared on every tick
+    if (t->tov_base > avr_->cycle) {
+        // Running up to MAX past a lowered TOP: tov_base is where the counter will be 0 again.
+        const uint32_t max = t->r_tcnth ? 0xFFFF : 0xFF;
+        const uint64_t ticks_left = (t->tov_base - avr_->cycle + presc - 1) / presc;
+        return static_cast<uint16_t>(max + 1 - ticks_left);
+    }
+    (void)hooks_.read_original(t->r_tcnt); // simavr's own count, into the data space
+    return count(t);
+}
+
+void Corrector::top_below_count(TimerFix& f, uint16_t before) {
+    // Datasheet 15.9.2 (CTC): "If the new value written to OCR1A is lower than the current value
+    // of TCNT1, the counter will miss the compare match. The counter will then have to count to
+    // its maximum value (0xFFFF) and wrap around starting at 0x0000 before the compare match can
+    // occur." simavr compares at once instead. Put the next period start at the wrap.
+    avr_timer_t* t = f.t;
+    const uint32_t presc = prescaler(t);
+    const uint32_t max = t->r_tcnth ? 0xFFFF : 0xFF;
+    const int64_t now = static_cast<int64_t>(avr_->cycle);
+    const int64_t wrap = now + int64_t(max + 1 - before) * presc;
+    shift_timer(t, wrap - static_cast<int64_t>(t->tov_base));
+    // Comparators above the count still match on the way up to MAX.
+    for (int i = AVR_TIMER_COMPB; i < AVR_TIMER_COMP_COUNT; ++i) {
+        if (!t->comp[i].r_ocr || ocr(t, i) <= before) continue;
+        const uint64_t at = uint64_t(ocr(t, i) - before + 1) * presc;
+        avr_cycle_timer_register(avr_, at, &Corrector::run_up_compare, &f.run_up[i]);
+    }
+}
+
+void Corrector::cancel_run_up(TimerFix& f) {
+    for (int i = AVR_TIMER_COMPB; i < AVR_TIMER_COMP_COUNT; ++i)
+        avr_cycle_timer_cancel(avr_, &Corrector::run_up_compare, &f.run_up[i]);
+}
+
+avr_cycle_count_t Corrector::run_up_compare(avr_t* avr, avr_cycle_count_t, void* param) {
+    const RunUp* r = static_cast<const RunUp*>(param);
+    avr_raise_interrupt(avr, &r->fix->t->comp[r->comp].interrupt);
+    return 0;
 }
 
 void Corrector::update_top_zero(TimerFix& f) {

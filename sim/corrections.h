@@ -31,8 +31,10 @@ struct Corrections {
     /// every timer tick (simavr never raises it).
     bool timer_ctc_top_zero = true;
     /// SIMAVR-NOTES 2: the counter keeps its value: starting a stopped timer counts from the
-    /// preloaded TCNTn, a stopped timer reads back its frozen count, and a TCNTn write takes effect
-    /// exactly (simavr counts from zero, reads 0, and rescales the written value).
+    /// preloaded TCNTn, a stopped timer reads back its frozen count, a TCNTn write takes effect
+    /// exactly, and in CTC mode an OCRnA written below the count is missed until the counter wraps
+    /// at MAX (simavr counts from zero, reads 0, rescales the written value, and compares at once
+    /// when TOP drops below the count, hiding the classic CTC bug).
     bool timer_keeps_count = true;
     /// SIMAVR-NOTES 3: a UART frame is start + data + parity (only if enabled) + stop bits
     /// (simavr always adds a parity bit: 11 bits at 8N1), recomputed whenever UBRRn, U2Xn, UCSZn,
@@ -101,11 +103,18 @@ class Corrector {
     uint32_t datasheet_frame_cycles() const;
 
   private:
+    struct TimerFix;
+    /// A compare that happens while the counter runs up to MAX past a lowered TOP.
+    struct RunUp {
+        TimerFix* fix;
+        int comp; ///< AVR_TIMER_COMPB or AVR_TIMER_COMPC
+    };
     struct TimerFix {
         Corrector* self = nullptr;
         avr_timer_t* t = nullptr;
         bool top_zero_active = false;    ///< our tick replaces simavr's missing one (item 1)
         uint32_t top_zero_prescaler = 0; ///< CPU cycles per timer tick while active
+        RunUp run_up[AVR_TIMER_COMP_COUNT] = {};
     };
 
     void install_timer(avr_timer_t* t);
@@ -119,6 +128,10 @@ class Corrector {
     uint16_t ocr(const avr_timer_t* t, int comp) const;
     avr_timer_wgm_t mode(const avr_timer_t* t) const;
     void update_top_zero(TimerFix& f);
+    uint16_t live_count(TimerFix& f);
+    void top_below_count(TimerFix& f, uint16_t count);
+    void cancel_run_up(TimerFix& f);
+    static avr_cycle_count_t run_up_compare(avr_t* avr, avr_cycle_count_t when, void* param);
     void align_count(avr_timer_t* t, uint16_t value);
     void shift_timer(avr_timer_t* t, int64_t delta_cycles);
     static avr_cycle_count_t top_zero_tick(avr_t* avr, avr_cycle_count_t when, void* param);

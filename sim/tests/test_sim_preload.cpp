@@ -1,4 +1,5 @@
-// SIMAVR-NOTES 2 (a timer counter keeps its value), against selftest_preload.
+// SIMAVR-NOTES 2 (a timer counter keeps its value), against selftest_preload and
+// selftest_top_write.
 // Each step_x / step_y toggle comes 10 cycles after its flag: response 4 + jmp 3 + push 2 + ldi 1
 // (the main code is 1-cycle nops, so a flag never waits for a longer instruction).
 #include "selftest_elf.h"
@@ -102,4 +103,50 @@ TEST(SimTimerKeepsCount, StockSimavrCountsFromZero) {
     const std::vector<uint64_t> y = between(r.y, r.t0_write, r.t0_write + 600);
     ASSERT_EQ(y.size(), 1u);
     EXPECT_EQ(y[0], r.t0_write + (2048 - 1606) + kToOut);
+}
+
+namespace {
+
+struct TopWriteRun {
+    uint64_t start, write;
+    std::vector<uint64_t> x, y; ///< TIMER1_COMPA / TIMER1_COMPB toggles
+};
+
+TopWriteRun run_top_write(const Corrections& c) {
+    Sim sim(options("selftest_top_write", c));
+    TopWriteRun r{};
+    EXPECT_TRUE(sim.run_until_pc(sim.symbol("t1_start"), ms(1)));
+    r.start = sim.cycle();
+    EXPECT_TRUE(sim.run_until_pc(sim.symbol("top_write"), ms(1)));
+    r.write = sim.cycle();
+    sim.run_until_cycle(r.write + 65600);
+    for (const Edge& e : sim.edges_of("step_x")) r.x.push_back(e.cycle);
+    for (const Edge& e : sim.edges_of("step_y")) r.y.push_back(e.cycle);
+    return r;
+}
+
+constexpr uint64_t kFromSleep = 8 + 6; // response from idle sleep + vector/ISR up to the OUT
+
+} // namespace
+
+TEST(SimTimerKeepsCount, CorrectedLoweredTopWaitsForTheWrap) {
+    REQUIRE_SELFTEST("selftest_top_write");
+    const TopWriteRun r = run_top_write(Corrections::all());
+    const uint64_t count = r.write - r.start; // prescaler 1 from 0
+    ASSERT_EQ(count, 606u);
+    ASSERT_GE(r.x.size(), 3u);
+    // Up to 0xFFFF, wrap, up to the new TOP = 100: then every 101 cycles.
+    EXPECT_EQ(r.x[0], r.write + (0x10000 - count) + 101 + kFromSleep);
+    EXPECT_EQ(r.x[1] - r.x[0], 101u);
+    // OCR1B = 5000 lies on the way up: its compare still happens.
+    ASSERT_FALSE(r.y.empty());
+    EXPECT_EQ(r.y[0], r.write + (5000 - count + 1) + kFromSleep);
+}
+
+TEST(SimTimerKeepsCount, StockSimavrComparesAtOnce) {
+    REQUIRE_SELFTEST("selftest_top_write");
+    const TopWriteRun r = run_top_write(all_but(&Corrections::timer_keeps_count));
+    ASSERT_FALSE(r.x.empty());
+    EXPECT_LT(r.x[0], r.write + 101); // no 4 ms wait: the firmware bug would go unnoticed
+    EXPECT_TRUE(r.y.empty() || r.y[0] > r.write + 0x10000); // and no compare B on the way up
 }
