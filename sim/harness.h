@@ -187,9 +187,10 @@ class Sim {
     void load_eeprom(const std::string& path); ///< raw image, at most 1024 bytes
     void save_eeprom(const std::string& path) const;
 
-    /// Resets the chip as the Uno's DTR reset does: registers to their reset values, EEPROM kept,
-    /// pins driven by set_input() restored (SIMAVR-NOTES 8). The cycle count keeps running and
-    /// the records keep growing; bytes still on the wire are delivered after the reset.
+    /// Resets the chip as the Uno's DTR reset does (without the bootloader's delay): registers to
+    /// their reset values, EEPROM kept, pins driven by set_input() restored (SIMAVR-NOTES 8). The
+    /// cycle count keeps running and the records keep growing. Bytes already in the receiver are
+    /// lost, as on the chip; bytes not yet sent wait until the firmware enables it again.
     void reset();
     uint32_t resets() const { return resets_; }
 

@@ -228,7 +228,8 @@ int main(int argc, char** argv) {
                 }
             }
             if (wait_idle) {
-                for (int tries = 0; tries < 100000 && !g_stop; ++tries) {
+                // At most about 10 minutes of simulated time (each try is 10-110 ms).
+                for (int tries = 0; tries < 6000 && !g_stop; ++tries) {
                     const std::string s = grbl.status(ms(100));
                     if (s.compare(0, 5, "<Idle") == 0) break;
                     sim.run_for(ms(10));
