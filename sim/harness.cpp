@@ -26,7 +26,6 @@ constexpr const char* kMcu = "atmega328p";
 // While the receiver cannot take a byte (disabled, XOFF), the line is checked again this often:
 // 256 cycles = 16 us, a fifth of a frame, so a byte starts at most that late once it can.
 constexpr uint64_t kBlockedRetryCycles = 256;
-constexpr uint8_t kIrqNotifyRunning = AVR_INT_IRQ_RUNNING;
 
 int g_log_level = LOG_ERROR;
 
@@ -90,7 +89,8 @@ Sim::Sim(const Options& opt) : opt_(opt) {
         avr_int_vector_t* v = avr_->interrupts.vector[i];
         if (!v || !v->vector) continue;
         vector_hooks_.push_back(std::unique_ptr<VectorHook>(new VectorHook{this, v->vector}));
-        avr_irq_register_notify(&v->irq[kIrqNotifyRunning], &Sim::vector_cb,
+        // RUNNING rises when the CPU accepts this vector and falls at its RETI.
+        avr_irq_register_notify(&v->irq[AVR_INT_IRQ_RUNNING], &Sim::vector_cb,
                                 vector_hooks_.back().get());
     }
 
