@@ -82,6 +82,27 @@ TEST_F(MotionTest, FeedHoldStopsAlongThePathLosesNoStepAndResumes) {
     EXPECT_EQ(edges[1], 20 * 80);
 }
 
+TEST_F(MotionTest, FeedHoldWhileIdleQueuesMovesUntilCycleStart) {
+    ll::motion::feed_hold();
+    EXPECT_EQ(ll::motion::state(), State::Held);
+    for (int i = 1; i <= 10; ++i) lltest::line_to({i * 1.0, 0, 0, 0}, 3000);
+    lltest::run_for(16000000 / 10);
+    EXPECT_TRUE(ll::host::edges().empty()); // nothing moved, not even the enable pin
+    EXPECT_EQ(ll::motion::state(), State::Held);
+    EXPECT_EQ(ll::motion::blocks_free(), ll::kPlannerSize - 10);
+    ll::motion::cycle_start();
+    ASSERT_TRUE(lltest::run_until(State::Idle));
+    int32_t edges[ll::kAxes];
+    lltest::count_steps(edges);
+    EXPECT_EQ(edges[0], 800);
+    // With all ten moves planned before the start, they run as one: no stop at the joints, so
+    // 10 mm at F3000 and 1000 mm/s^2 take 0.2 s plus 0.05 s of acceleration and deceleration.
+    double seconds =
+        static_cast<double>(ll::host::edges().back().cycle - ll::host::edges().front().cycle) /
+        16e6;
+    EXPECT_NEAR(seconds, 0.25, 0.01);
+}
+
 TEST_F(MotionTest, ShortSegmentCircleRunsAtFullFeed) {
     // The benchmark's circle: radius 10 mm, 0.1 mm chords, F3000, 1000 mm/s^2.
     const double r = 10, pi = std::acos(-1.0);
