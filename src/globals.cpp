@@ -8,6 +8,7 @@ namespace ll {
 
 RunQueue g_runs;
 StepExec g_exec;
+volatile uint16_t g_starvations;
 Settings g_settings;
 
 namespace rt {

@@ -19,7 +19,6 @@ struct Motion {
     bool begun = false;      ///< the planner's first move is in the step generator
     bool enabled = false;    ///< stepper drivers enabled
     uint32_t idle_since = 0; ///< hal::millis() when motion last stopped
-    uint32_t starvations;
 };
 
 Motion g_motion;
@@ -98,7 +97,7 @@ void init() {
     m.begun = false;
     m.enabled = false;
     m.state = State::Idle;
-    m.starvations = 0;
+    g_starvations = 0;
 }
 
 bool can_accept() {
@@ -130,7 +129,7 @@ void poll() {
     produce(m);
     if (!g_exec.running) {
         if (g_exec.starved && (m.begun || !m.planner.empty()) && !m.gen.stopped()) {
-            ++m.starvations; // the queue ran dry in the middle of a move
+            g_starvations = static_cast<uint16_t>(g_starvations + 1); // dry mid-move
         }
         g_exec.starved = 0;
         if (!g_runs.empty() && m.state != State::Held) {
@@ -251,7 +250,7 @@ void settings_changed() {
 }
 
 uint32_t starvations() {
-    return mo().starvations;
+    return g_starvations;
 }
 
 } // namespace motion

@@ -58,5 +58,9 @@ struct StepExec {
 
 extern RunQueue g_runs;
 extern StepExec g_exec;
+/// Times the step timer stopped for want of runs while a move was still being produced (the
+/// queue ran dry mid-move). Counted by the main loop; a named global so that the simavr checks
+/// can read it from the chip's RAM by symbol.
+extern volatile uint16_t g_starvations;
 
 } // namespace ll
