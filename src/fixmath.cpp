@@ -1,5 +1,7 @@
 #include "lowlevel/fixmath.h"
 
+#include "lowlevel/pgm.h"
+
 namespace ll {
 
 uint16_t isqrt32(uint32_t v) {
@@ -41,6 +43,86 @@ uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift) {
 uint32_t shl_sat(uint32_t x, uint8_t k) {
     if (k >= 32) return x ? 0xFFFFFFFFul : 0;
     return x > (0xFFFFFFFFul >> k) ? 0xFFFFFFFFul : x << k;
+}
+
+namespace {
+
+// atan(2^-i) in radians x 2^29 for i < 10; beyond, atan(2^-i) = 2^-i to the last bit.
+const uint32_t kAtanQ29[10] LL_PROGMEM = {421657428, 248918915, 131521918, 66762579, 33510843,
+                                          16771758,  8387925,   4194219,   2097141,  1048575};
+
+// (a * b) >> 30 for Q30 operands.
+int32_t mul_q30(int32_t a, int32_t b) {
+    return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> 30);
+}
+
+// 1 - x * r * t in Q30, with r a Q30 reciprocal constant: one step of a Horner series.
+int32_t horner(int32_t x, int32_t r, int32_t t) {
+    return (1l << 30) - mul_q30(mul_q30(x, r), t);
+}
+
+} // namespace
+
+int32_t atan2_q29(int32_t y, int32_t x) {
+    if (x == 0 && y == 0) return 0;
+    // Bring the vector into the right half plane with a quarter turn, then normalise it to
+    // 29 bits so that the CORDIC gain (1.647) cannot overflow.
+    int32_t z = 0;
+    if (x < 0) {
+        int32_t t = x;
+        if (y >= 0) {
+            x = y;
+            y = -t;
+            z = kPiQ29 / 2;
+        } else {
+            x = -y;
+            y = t;
+            z = -kPiQ29 / 2;
+        }
+    }
+    uint32_t big = abs32(x) > abs32(y) ? abs32(x) : abs32(y);
+    while (big >= (1ul << 29)) {
+        x >>= 1;
+        y >>= 1;
+        big >>= 1;
+    }
+    while (big < (1ul << 28)) {
+        x *= 2;
+        y *= 2;
+        big <<= 1;
+    }
+    for (uint8_t i = 0; i < 30; ++i) {
+        int32_t a = i < 10 ? static_cast<int32_t>(flash_read_u32(&kAtanQ29[i]))
+                           : static_cast<int32_t>(1l << (29 - i));
+        int32_t xs = x >> i, ys = y >> i;
+        if (y > 0) {
+            x += ys;
+            y -= xs;
+            z += a;
+        } else {
+            x -= ys;
+            y += xs;
+            z -= a;
+        }
+    }
+    return z;
+}
+
+void small_angle_q30(int32_t h, int32_t& c, int32_t& s, int32_t& k) {
+    // Reciprocals 1/n in Q30 for the series' coefficient ratios.
+    const int32_t r2 = 536870912, r6 = 178956971, r12 = 89478485, r20 = 53687091, r30 = 35791394,
+                  r42 = 25565282, r56 = 19173961, r72 = 14913081;
+    int32_t h2 = mul_q30(h, h);
+    // cos h = 1 - h^2/2 (1 - h^2/12 (1 - h^2/30 (1 - h^2/56)))
+    c = horner(h2, r2, horner(h2, r12, horner(h2, r30, horner(h2, r56, 1l << 30))));
+    // sin h = h (1 - h^2/6 (1 - h^2/20 (1 - h^2/42 (1 - h^2/72))))
+    s = mul_q30(h, horner(h2, r6, horner(h2, r20, horner(h2, r42, horner(h2, r72, 1l << 30)))));
+    // tan x = x (1 + x^2/3 + 2 x^4/15 + 17 x^6/315) with x = h/4; k = 4/3 tan(h/4).
+    int32_t x = h / 4;
+    int32_t x2 = mul_q30(x, x);
+    const int32_t r3 = 357913941, c5 = 143165577, c7 = 57947971; // 1/3, 2/15, 17/315
+    int32_t poly = (1l << 30) + mul_q30(x2, r3 + mul_q30(x2, c5 + mul_q30(x2, c7)));
+    k = mul_q30(mul_q30(x, poly), 1431655765); // x 4/3
 }
 
 namespace {

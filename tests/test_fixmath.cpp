@@ -86,3 +86,32 @@ TEST(FixMath, NumConversionFloorsAndSaturates) {
     EXPECT_EQ(ll::Num(1, 100).mul(ll::Num(1, 100)).u32(), 0xFFFFFFFFu); // saturates
     EXPECT_EQ(ll::Num(1, -100).mul(ll::Num(1, -100)).u32(), 0u);        // underflows to zero
 }
+
+TEST(FixMath, Atan2IsExactTo2ToTheMinus24) {
+    std::mt19937 rng(4);
+    double worst = 0;
+    for (int i = 0; i < 100000; ++i) {
+        int32_t x = static_cast<int32_t>(rng()) >> (rng() % 31);
+        int32_t y = static_cast<int32_t>(rng()) >> (rng() % 31);
+        if (x == 0 && y == 0) continue;
+        double want = std::atan2(static_cast<double>(y), static_cast<double>(x));
+        double got = ll::atan2_q29(y, x) / std::ldexp(1.0, 29);
+        double err = std::fabs(got - want);
+        if (err > 3.0) err = std::fabs(err - 2 * M_PI); // +pi and -pi are the same angle
+        worst = std::max(worst, err);
+    }
+    EXPECT_LT(worst, std::ldexp(1.0, -24));
+    EXPECT_NEAR(ll::atan2_q29(0, 5), 0, 4);
+    EXPECT_NEAR(ll::atan2_q29(5, 0), ll::kPiQ29 / 2, 4);
+    EXPECT_NEAR(ll::atan2_q29(0, -5), ll::kPiQ29, 4);
+}
+
+TEST(FixMath, SmallAngleSeriesGiveCosSinAndTheArcControlArm) {
+    for (double h = -0.4; h <= 0.4; h += 0.001) {
+        int32_t c, s, k;
+        ll::small_angle_q30(static_cast<int32_t>(std::lround(h * std::ldexp(1.0, 30))), c, s, k);
+        EXPECT_NEAR(c / std::ldexp(1.0, 30), std::cos(h), 4e-9) << h;
+        EXPECT_NEAR(s / std::ldexp(1.0, 30), std::sin(h), 4e-9) << h;
+        EXPECT_NEAR(k / std::ldexp(1.0, 30), 4.0 / 3 * std::tan(h / 4), 4e-9) << h;
+    }
+}

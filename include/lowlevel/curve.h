@@ -1,0 +1,89 @@
+// Curves stepped in the low level (seed part IV): circular and elliptic arcs (helical when the
+// plane's normal axis moves too) and cubic Beziers, walked in tick space without chords.
+//
+// A curve is walked as a sequence of cubic pieces (seed §10.1: a partition of the parameter
+// interval, each part with its own parameter step). A piece is sampled at N = 2^m parameter
+// values, with N larger than the piece's largest axis speed (its hodograph bound), so that two
+// consecutive samples are at most one tick apart on every axis: the visited positions are the
+// samples rounded to the nearest tick, strictly successive, within 0.71 tick of the piece.
+// Samples are produced by forward differencing in 64-bit fixed point (Q40 ticks, relative to
+// the piece start): three additions per axis and per sample, no multiplication, no square root,
+// and since N is a power of two the differences are set up with shifts.
+//
+// Arcs and ellipses (X = cu + ru cos t, Y = cv + rv sin t, docs/curves.md): pieces of at most
+// 22.5 degrees (and 2000 ticks), each the cubic whose arms are 4/3 tan(h/4) long, which stays
+// within 7e-8 radius of the true curve; the unit vector (cos t, sin t) is advanced from piece to
+// piece by an integer rotation whose sine and cosine come from their series where the arc is
+// prepared. Beziers are cut into 2^j pieces of equal parameter length, each exactly the
+// corresponding part of the curve (its ends and tangents evaluated by Horner's rule).
+#pragma once
+
+#include "lowlevel/config.h"
+
+namespace ll {
+
+/// Walks one curve in the plane (u, v), with an optional third axis w moving linearly along it
+/// (a helix). Coordinates are ticks; `_q8` values are ticks x 256.
+class CurveWalker {
+  public:
+    /// Where a curve starts and ends: the machine's positions (ticks: the walk starts at
+    /// `start` and its last step lands exactly on `end`) and the commanded points of the plane
+    /// (ticks x 256, not rounded: the curve's geometry is computed from these).
+    struct Ends {
+        int32_t start[3], end[3];
+        int32_t start_q8[2], end_q8[2];
+    };
+
+    /// An arc of the ellipse (circle when ru = rv) with centre `centre_q8` and semi-axes
+    /// `radii_q8`, from the commanded start to the commanded end (their directions seen from
+    /// the centre), clockwise or not, plus `turns` extra full turns. A closed arc (start = end)
+    /// is a full turn. Returns false when the geometry is degenerate.
+    bool arc(const Ends& e, const int32_t centre_q8[2], const uint32_t radii_q8[2], bool clockwise,
+             uint8_t turns);
+    /// The cubic Bezier from the commanded start through the control points `p1_q8`, `p2_q8`
+    /// (u, v) to the commanded end; w moves linearly with the parameter.
+    bool bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2_q8[2]);
+
+    /// Advances to the next sample. `moved` gets the bits (u = 1, v = 2, w = 4) of the axes that
+    /// step to reach it, `neg` those that step towards negative coordinates. A sample may move
+    /// no axis. Returns false once the curve is complete (the position is then `end`).
+    bool next(uint8_t& moved, uint8_t& neg);
+
+    /// Displacement of the sample that next() will produce, ticks x 2^16 per axis: its chord,
+    /// from which the step generator times it.
+    void next_delta_q16(int32_t d[3]) const;
+
+    /// Sum over the remaining pieces of nothing: samples left in the current piece (tests).
+    uint16_t samples_left() const { return left_; }
+
+    int32_t pos[3]; ///< current position, ticks (u, v, w)
+
+  private:
+    bool next_piece();
+    void start_piece(const int32_t p0[3], const int32_t p1[3], const int32_t p2[3],
+                     const int32_t p3[3]);
+    void arc_point(int32_t c, int32_t s, int32_t out[2]) const;
+    void bezier_point(uint32_t a_q20, int32_t out[2], int32_t slope[2]) const;
+
+    // Current piece: forward differences, Q40 ticks relative to base_.
+    int64_t f_[3], d1_[3], d2_[3], d3_[3];
+    int32_t base_[3];
+    uint16_t left_;
+    // Curve
+    uint8_t kind_;          ///< 0 done, 1 arc, 2 bezier
+    uint16_t pieces_;       ///< pieces not started yet
+    uint16_t piece_count_;  ///< pieces in the curve
+    int32_t end_[3];        ///< final position, ticks
+    int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
+    int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
+    // Arc: unit vector at the start of the next piece, rotation per piece, arm length (Q30).
+    int32_t centre_[2];
+    uint32_t radii_[2];
+    int32_t c_, s_, rot_c_, rot_s_, arm_;
+    int32_t end_c_, end_s_; ///< direction of the end point (the last piece lands there)
+    // Bezier: polynomial coefficients (ticks x 256), B(a) = c0 + c1 a + c2 a^2 + c3 a^3.
+    int64_t poly_[4][2];
+    uint8_t log_pieces_; ///< Bezier: 2^j pieces
+};
+
+} // namespace ll

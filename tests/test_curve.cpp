@@ -1,0 +1,316 @@
+// Curves walked in tick space (seed part IV): every visited position within 1.0 tick of the
+// true curve (Euclidean, in ticks), strictly successive positions, exact end point.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <random>
+
+#include "lowlevel/curve.h"
+
+namespace {
+
+const double kPi = std::acos(-1.0);
+
+struct Result {
+    double worst = 0; // largest distance to the curve, ticks
+    long samples = 0;
+    bool successive = true;
+    bool ended = false;
+};
+
+// Walks the curve, measuring each visited position's distance with `dist`.
+Result walk(ll::CurveWalker& w, const int32_t end[3],
+            const std::function<double(const int32_t p[3])>& dist) {
+    Result r;
+    int32_t prev[3] = {w.pos[0], w.pos[1], w.pos[2]};
+    uint8_t moved, neg;
+    while (w.next(moved, neg)) {
+        ++r.samples;
+        for (int a = 0; a < 3; ++a) {
+            int32_t d = w.pos[a] - prev[a];
+            if (d < -1 || d > 1) r.successive = false;
+            bool m = (moved >> a) & 1, n = (neg >> a) & 1;
+            if (m != (d != 0) || (m && n != (d < 0))) r.successive = false;
+            prev[a] = w.pos[a];
+        }
+        r.worst = std::max(r.worst, dist(w.pos));
+    }
+    r.ended = w.pos[0] == end[0] && w.pos[1] == end[1] && w.pos[2] == end[2];
+    return r;
+}
+
+// Closest distance from (x, y) to the ellipse (cx + a cos t, cy + b sin t), by Newton on t from
+// `t` (the previous solution: the walk moves along the curve) or, when that does not land close,
+// from a coarse scan. `t` is updated.
+double ellipse_distance(double x, double y, double cx, double cy, double a, double b, double& t0) {
+    double px = x - cx, py = y - cy;
+    auto newton = [&](double t) {
+        for (int i = 0; i < 8; ++i) {
+            double ex = a * std::cos(t), ey = b * std::sin(t);
+            double dx = -a * std::sin(t), dy = b * std::cos(t);
+            double f = (ex - px) * dx + (ey - py) * dy;
+            double df =
+                dx * dx + dy * dy + (ex - px) * (-a * std::cos(t)) + (ey - py) * (-b * std::sin(t));
+            if (df <= 0) break;
+            t -= f / df;
+        }
+        return t;
+    };
+    double t = newton(t0);
+    double d = std::hypot(a * std::cos(t) - px, b * std::sin(t) - py);
+    if (d < 0.5) {
+        t0 = t;
+        return d;
+    }
+    double best_t = 0, best = 1e300;
+    for (int i = 0; i < 256; ++i) {
+        double u = 2 * kPi * i / 256;
+        double e = std::hypot(a * std::cos(u) - px, b * std::sin(u) - py);
+        if (e < best) {
+            best = e;
+            best_t = u;
+        }
+    }
+    t = best_t;
+    for (int i = 0; i < 30; ++i) {
+        double ex = a * std::cos(t), ey = b * std::sin(t);
+        double dx = -a * std::sin(t), dy = b * std::cos(t);
+        double f = (ex - px) * dx + (ey - py) * dy;
+        double df =
+            dx * dx + dy * dy + (ex - px) * (-a * std::cos(t)) + (ey - py) * (-b * std::sin(t));
+        if (df == 0) break;
+        t -= f / df;
+    }
+    double e = std::hypot(a * std::cos(t) - px, b * std::sin(t) - py);
+    t0 = e < best ? t : best_t;
+    return std::min(best, e);
+}
+
+// The machine's rounded positions and the commanded (exact) points of a curve's ends.
+ll::CurveWalker::Ends ends(const int32_t start[3], const int32_t end[3], double sx, double sy,
+                           double ex, double ey) {
+    ll::CurveWalker::Ends e;
+    for (int a = 0; a < 3; ++a) {
+        e.start[a] = start[a];
+        e.end[a] = end[a];
+    }
+    e.start_q8[0] = static_cast<int32_t>(std::lround(sx * 256));
+    e.start_q8[1] = static_cast<int32_t>(std::lround(sy * 256));
+    e.end_q8[0] = static_cast<int32_t>(std::lround(ex * 256));
+    e.end_q8[1] = static_cast<int32_t>(std::lround(ey * 256));
+    return e;
+}
+
+double log_uniform(std::mt19937& rng, double lo, double hi) {
+    std::uniform_real_distribution<double> u(std::log(lo), std::log(hi));
+    return std::exp(u(rng));
+}
+
+} // namespace
+
+TEST(Curve, RandomArcsStayWithinOneTickOfTheCircleAndEndExactly) {
+    std::mt19937 rng(51);
+    std::uniform_real_distribution<double> ang(-kPi, kPi), frac(0, 1);
+    double worst = 0;
+    long samples = 0;
+    for (int i = 0; i < 600; ++i) {
+        double r = log_uniform(rng, 1, 50000);
+        double cx = frac(rng) * 1000 - 500, cy = frac(rng) * 1000 - 500;
+        double t0 = ang(rng);
+        bool full = i % 5 == 0;
+        bool cw = (rng() & 1) != 0;
+        double sweep = full ? 2 * kPi : frac(rng) * 2 * kPi;
+        double t1 = t0 + (cw ? -sweep : sweep);
+        int32_t start[3] = {static_cast<int32_t>(std::lround(cx + r * std::cos(t0))),
+                            static_cast<int32_t>(std::lround(cy + r * std::sin(t0))), 0};
+        int32_t end[3] = {static_cast<int32_t>(std::lround(cx + r * std::cos(t1))),
+                          static_cast<int32_t>(std::lround(cy + r * std::sin(t1))), 0};
+        if (full) {
+            end[0] = start[0];
+            end[1] = start[1];
+        }
+        int32_t c[2] = {static_cast<int32_t>(std::lround(cx * 256)),
+                        static_cast<int32_t>(std::lround(cy * 256))};
+        uint32_t rad[2] = {static_cast<uint32_t>(std::lround(r * 256)),
+                           static_cast<uint32_t>(std::lround(r * 256))};
+        ll::CurveWalker::Ends e = ends(start, end, cx + r * std::cos(t0), cy + r * std::sin(t0),
+                                       full ? cx + r * std::cos(t0) : cx + r * std::cos(t1),
+                                       full ? cy + r * std::sin(t0) : cy + r * std::sin(t1));
+        ll::CurveWalker w{};
+        ASSERT_TRUE(w.arc(e, c, rad, cw, 0)) << i;
+        Result res = walk(w, end, [&](const int32_t p[3]) {
+            return std::fabs(std::hypot(p[0] - c[0] / 256.0, p[1] - c[1] / 256.0) - rad[0] / 256.0);
+        });
+        ASSERT_TRUE(res.successive) << "arc " << i;
+        ASSERT_TRUE(res.ended) << "arc " << i;
+        ASSERT_LE(res.worst, 1.0) << "arc " << i << " r=" << r;
+        worst = std::max(worst, res.worst);
+        samples += res.samples;
+    }
+    std::printf("600 arcs, %ld samples, worst distance to the circle %.3f tick\n", samples, worst);
+}
+
+TEST(Curve, HelicalArcMovesTheNormalAxisLinearlyWithTheAngle) {
+    // A full turn of radius 800 ticks rising 400 ticks, counter-clockwise.
+    int32_t start[3] = {800, 0, 0}, end[3] = {800, 0, 400};
+    int32_t c[2] = {0, 0};
+    uint32_t rad[2] = {800 * 256, 800 * 256};
+    ll::CurveWalker w{};
+    ASSERT_TRUE(w.arc(ends(start, end, 800, 0, 800, 0), c, rad, false, 0));
+    double worst = 0;
+    Result res = walk(w, end, [&](const int32_t p[3]) {
+        double t = std::atan2(p[1], p[0]);
+        if (t < 0) t += 2 * kPi;
+        double radial = std::hypot(p[0], p[1]) - 800;
+        double z = 400 * t / (2 * kPi);
+        // near the seam, the angle wraps: take the closer of both ends
+        double dz = std::min(std::fabs(p[2] - z), std::fabs(p[2] - (z + 400)));
+        double d = std::hypot(radial, dz);
+        worst = std::max(worst, d);
+        return d;
+    });
+    EXPECT_TRUE(res.successive);
+    EXPECT_TRUE(res.ended);
+    EXPECT_LE(res.worst, 1.0);
+}
+
+TEST(Curve, ExtraTurnsAddFullCircles) {
+    int32_t start[3] = {100, 0, 0}, end[3] = {0, 100, 0};
+    int32_t c[2] = {0, 0};
+    uint32_t rad[2] = {100 * 256, 100 * 256};
+    ll::CurveWalker w{};
+    ASSERT_TRUE(w.arc(ends(start, end, 100, 0, 0, 100), c, rad, false, 2)); // a quarter + 2 turns
+    long x_steps = 0;
+    uint8_t moved, neg;
+    while (w.next(moved, neg)) x_steps += moved & 1;
+    // X travels 4 r per turn and r on the quarter: about 900 ticks.
+    EXPECT_NEAR(x_steps, 900, 4);
+}
+
+TEST(Curve, RandomEllipsesStayWithinOneTickAndEndExactly) {
+    std::mt19937 rng(52);
+    std::uniform_real_distribution<double> ang(-kPi, kPi), frac(0, 1);
+    double worst = 0;
+    for (int i = 0; i < 200; ++i) {
+        double a = log_uniform(rng, 2, 20000), b = a * (0.1 + 3 * frac(rng));
+        double cx = frac(rng) * 100, cy = frac(rng) * 100;
+        double t0 = ang(rng), sweep = (i % 4 == 0) ? 2 * kPi : frac(rng) * 2 * kPi;
+        bool cw = (rng() & 1) != 0;
+        double t1 = t0 + (cw ? -sweep : sweep);
+        int32_t start[3] = {static_cast<int32_t>(std::lround(cx + a * std::cos(t0))),
+                            static_cast<int32_t>(std::lround(cy + b * std::sin(t0))), 0};
+        int32_t end[3] = {static_cast<int32_t>(std::lround(cx + a * std::cos(t1))),
+                          static_cast<int32_t>(std::lround(cy + b * std::sin(t1))), 0};
+        if (i % 4 == 0) {
+            end[0] = start[0];
+            end[1] = start[1];
+        }
+        int32_t c[2] = {static_cast<int32_t>(std::lround(cx * 256)),
+                        static_cast<int32_t>(std::lround(cy * 256))};
+        uint32_t rad[2] = {static_cast<uint32_t>(std::lround(a * 256)),
+                           static_cast<uint32_t>(std::lround(b * 256))};
+        bool closed = i % 4 == 0;
+        ll::CurveWalker::Ends e = ends(start, end, cx + a * std::cos(t0), cy + b * std::sin(t0),
+                                       closed ? cx + a * std::cos(t0) : cx + a * std::cos(t1),
+                                       closed ? cy + b * std::sin(t0) : cy + b * std::sin(t1));
+        ll::CurveWalker w{};
+        ASSERT_TRUE(w.arc(e, c, rad, cw, 0)) << i;
+        double track = t0;
+        Result res = walk(w, end, [&](const int32_t p[3]) {
+            return ellipse_distance(p[0], p[1], c[0] / 256.0, c[1] / 256.0, rad[0] / 256.0,
+                                    rad[1] / 256.0, track);
+        });
+        ASSERT_TRUE(res.successive) << "ellipse " << i;
+        ASSERT_TRUE(res.ended) << "ellipse " << i;
+        ASSERT_LE(res.worst, 1.0) << "ellipse " << i << " a=" << a << " b=" << b;
+        worst = std::max(worst, res.worst);
+    }
+    std::printf("200 ellipses, worst distance %.3f tick\n", worst);
+}
+
+TEST(Curve, RandomBeziersStayWithinOneTickAndEndExactly) {
+    std::mt19937 rng(53);
+    std::uniform_real_distribution<double> u(-1, 1);
+    double worst = 0;
+    for (int i = 0; i < 200; ++i) {
+        double scale = log_uniform(rng, 3, 30000);
+        double p[4][2];
+        for (auto& q : p) {
+            q[0] = u(rng) * scale;
+            q[1] = u(rng) * scale;
+        }
+        int32_t start[3] = {static_cast<int32_t>(std::lround(p[0][0])),
+                            static_cast<int32_t>(std::lround(p[0][1])), 0};
+        int32_t end[3] = {static_cast<int32_t>(std::lround(p[3][0])),
+                          static_cast<int32_t>(std::lround(p[3][1])), 0};
+        ll::CurveWalker::Ends e = ends(start, end, p[0][0], p[0][1], p[3][0], p[3][1]);
+        for (int k = 0; k < 2; ++k) { // the commanded points, as the walker sees them
+            p[0][k] = e.start_q8[k] / 256.0;
+            p[3][k] = e.end_q8[k] / 256.0;
+        }
+        int32_t c1[2] = {static_cast<int32_t>(std::lround(p[1][0] * 256)),
+                         static_cast<int32_t>(std::lround(p[1][1] * 256))};
+        int32_t c2[2] = {static_cast<int32_t>(std::lround(p[2][0] * 256)),
+                         static_cast<int32_t>(std::lround(p[2][1] * 256))};
+        p[1][0] = c1[0] / 256.0;
+        p[1][1] = c1[1] / 256.0;
+        p[2][0] = c2[0] / 256.0;
+        p[2][1] = c2[1] / 256.0;
+        auto at = [&](double t, int k) {
+            double s = 1 - t;
+            return s * s * s * p[0][k] + 3 * s * s * t * p[1][k] + 3 * s * t * t * p[2][k] +
+                   t * t * t * p[3][k];
+        };
+        ll::CurveWalker w{};
+        ASSERT_TRUE(w.bezier(e, c1, c2)) << i;
+        // Distance: Newton on the parameter from the last solution (the walk moves along the
+        // curve); where that does not land close (a tight turn), a global scan refined by golden
+        // section.
+        auto d1 = [&](double t, int k) {
+            double s = 1 - t;
+            return 3 * s * s * (p[1][k] - p[0][k]) + 6 * s * t * (p[2][k] - p[1][k]) +
+                   3 * t * t * (p[3][k] - p[2][k]);
+        };
+        auto d2 = [&](double t, int k) {
+            return 6 * (1 - t) * (p[2][k] - 2 * p[1][k] + p[0][k]) +
+                   6 * t * (p[3][k] - 2 * p[2][k] + p[1][k]);
+        };
+        double last_t = 0;
+        Result res = walk(w, end, [&](const int32_t q[3]) {
+            auto dist = [&](double t) { return std::hypot(at(t, 0) - q[0], at(t, 1) - q[1]); };
+            auto newton = [&](double t) {
+                for (int k = 0; k < 12; ++k) {
+                    double f = 0, df = 0;
+                    for (int c = 0; c < 2; ++c) {
+                        double err = at(t, c) - q[c];
+                        f += err * d1(t, c);
+                        df += d1(t, c) * d1(t, c) + err * d2(t, c);
+                    }
+                    if (df <= 0) break;
+                    t = std::min(1.0, std::max(0.0, t - f / df));
+                }
+                return t;
+            };
+            double t = newton(last_t);
+            double best = dist(t);
+            if (best >= 0.5) { // a tight turn: Newton from many starting points
+                for (int k = 0; k <= 200; ++k) {
+                    double cand = newton(k / 200.0);
+                    if (dist(cand) < best) {
+                        best = dist(cand);
+                        t = cand;
+                    }
+                }
+            }
+            last_t = t;
+            return best;
+        });
+        ASSERT_TRUE(res.successive) << "bezier " << i;
+        ASSERT_TRUE(res.ended) << "bezier " << i;
+        ASSERT_LE(res.worst, 1.0) << "bezier " << i << " scale " << scale;
+        worst = std::max(worst, res.worst);
+    }
+    std::printf("200 Beziers, worst distance %.3f tick\n", worst);
+}
