@@ -314,3 +314,113 @@ TEST(Curve, RandomBeziersStayWithinOneTickAndEndExactly) {
     }
     std::printf("200 Beziers, worst distance %.3f tick\n", worst);
 }
+
+namespace {
+
+ll::CurveParams arc_params(double sx, double sy, double ex, double ey, double cx, double cy,
+                           double ru, double rv, bool cw, uint8_t turns = 0) {
+    ll::CurveParams p{};
+    p.kind = ll::kCurveArc;
+    p.clockwise = cw;
+    p.turns = turns;
+    p.start_um[0] = static_cast<int32_t>(std::lround(sx * 1000));
+    p.start_um[1] = static_cast<int32_t>(std::lround(sy * 1000));
+    p.end_um[0] = static_cast<int32_t>(std::lround(ex * 1000));
+    p.end_um[1] = static_cast<int32_t>(std::lround(ey * 1000));
+    p.a_um[0] = static_cast<int32_t>(std::lround(cx * 1000));
+    p.a_um[1] = static_cast<int32_t>(std::lround(cy * 1000));
+    p.b_um[0] = static_cast<int32_t>(std::lround(ru * 1000));
+    p.b_um[1] = static_cast<int32_t>(std::lround(rv * 1000));
+    return p;
+}
+
+double ellipse_arc_length(double a, double b, double t0, double t1) {
+    double s = 0;
+    const int n = 200000;
+    for (int i = 0; i < n; ++i) {
+        double t = t0 + (t1 - t0) * (i + 0.5) / n;
+        s += std::hypot(a * std::sin(t), b * std::cos(t)) * std::fabs(t1 - t0) / n;
+    }
+    return s;
+}
+
+} // namespace
+
+TEST(CurveShape, CircleLengthIsRadiusTimesSweepAndTangentsArePerpendicular) {
+    // Quarter circle of radius 10 mm from (10, 0) to (0, 10), anticlockwise.
+    ll::CurveShape sh;
+    ASSERT_TRUE(ll::curve_shape(arc_params(10, 0, 0, 10, 0, 0, 10, 10, false), 0, true, sh));
+    EXPECT_NEAR(sh.len_q8 / 256000.0, 10 * kPi / 2, 1e-5);
+    EXPECT_EQ(sh.min_radius_um, 10000u);
+    const double q = std::ldexp(1.0, 29);
+    EXPECT_NEAR(sh.start_dir[0] / q, 0, 1e-6); // going up (+v) at (10, 0)
+    EXPECT_NEAR(sh.start_dir[1] / q, 1, 1e-6);
+    EXPECT_NEAR(sh.end_dir[0] / q, -1, 1e-6); // going left at (0, 10)
+    // Clockwise the other way round: three quarters, tangent reversed.
+    ASSERT_TRUE(ll::curve_shape(arc_params(10, 0, 0, 10, 0, 0, 10, 10, true), 0, true, sh));
+    EXPECT_NEAR(sh.len_q8 / 256000.0, 10 * kPi * 1.5, 1e-5);
+    EXPECT_NEAR(sh.start_dir[1] / q, -1, 1e-6);
+    // Full circle plus one turn: 4 pi r.
+    ASSERT_TRUE(ll::curve_shape(arc_params(10, 0, 10, 0, 0, 0, 10, 10, false, 1), 0, true, sh));
+    EXPECT_NEAR(sh.len_q8 / 256000.0, 10 * kPi * 4, 1e-4);
+}
+
+TEST(CurveShape, HelixLengthAddsTheRiseInQuadrature) {
+    ll::CurveShape sh;
+    ASSERT_TRUE(ll::curve_shape(arc_params(10, 0, 10, 0, 0, 0, 10, 10, false), 5000, true, sh));
+    EXPECT_NEAR(sh.len_q8 / 256000.0, std::hypot(2 * kPi * 10, 5.0), 1e-4);
+    // The rise per radian is kept in whole µm: the direction is good to 1e-4 (it only sets the
+    // junction speed with the neighbouring moves).
+    EXPECT_NEAR(sh.start_dir[2] / std::ldexp(1.0, 29), 5.0 / std::hypot(2 * kPi * 10, 5.0), 1e-4);
+}
+
+TEST(CurveShape, EllipseLengthComesFromAdaptiveSimpsonWithinTenToTheMinusFive) {
+    // Quarter of the ellipse 30 x 10 from (30, 0) to (0, 10), and a whole 50 x 5 one.
+    ll::CurveShape sh;
+    ASSERT_TRUE(ll::curve_shape(arc_params(30, 0, 0, 10, 0, 0, 30, 10, false), 0, true, sh));
+    double want = ellipse_arc_length(30, 10, 0, kPi / 2);
+    EXPECT_NEAR(sh.len_q8 / 256000.0 / want, 1.0, 1e-5);
+    EXPECT_NEAR(sh.min_radius_um, 10000.0 * 10 / 30, 1); // b^2 / a
+    ASSERT_TRUE(ll::curve_shape(arc_params(50, 0, 50, 0, 0, 0, 50, 5, true), 0, true, sh));
+    want = ellipse_arc_length(50, 5, 0, 2 * kPi);
+    std::printf("ellipse 50x5: %.6f mm, exact %.6f mm (%.1e)\n", sh.len_q8 / 256000.0, want,
+                sh.len_q8 / 256000.0 / want - 1);
+    EXPECT_NEAR(sh.len_q8 / 256000.0 / want, 1.0, 1e-5);
+}
+
+TEST(CurveShape, BezierLengthAndCurvatureMatchNumericReferences) {
+    ll::CurveParams p{};
+    p.kind = ll::kCurveBezier;
+    const double pts[4][2] = {{0, 0}, {10, 20}, {30, -10}, {40, 10}};
+    p.start_um[0] = 0;
+    p.start_um[1] = 0;
+    p.a_um[0] = 10000;
+    p.a_um[1] = 20000;
+    p.b_um[0] = 30000;
+    p.b_um[1] = -10000;
+    p.end_um[0] = 40000;
+    p.end_um[1] = 10000;
+    ll::CurveShape sh;
+    ASSERT_TRUE(ll::curve_shape(p, 0, true, sh));
+    double len = 0, rmin = 1e300;
+    const int n = 100000;
+    for (int i = 0; i < n; ++i) {
+        double t = (i + 0.5) / n, s = 1 - t;
+        double dx = 3 * s * s * (pts[1][0] - pts[0][0]) + 6 * s * t * (pts[2][0] - pts[1][0]) +
+                    3 * t * t * (pts[3][0] - pts[2][0]);
+        double dy = 3 * s * s * (pts[1][1] - pts[0][1]) + 6 * s * t * (pts[2][1] - pts[1][1]) +
+                    3 * t * t * (pts[3][1] - pts[2][1]);
+        double ddx = 6 * s * (pts[2][0] - 2 * pts[1][0] + pts[0][0]) +
+                     6 * t * (pts[3][0] - 2 * pts[2][0] + pts[1][0]);
+        double ddy = 6 * s * (pts[2][1] - 2 * pts[1][1] + pts[0][1]) +
+                     6 * t * (pts[3][1] - 2 * pts[2][1] + pts[1][1]);
+        len += std::hypot(dx, dy) / n;
+        double r = std::pow(std::hypot(dx, dy), 3) / std::fabs(dx * ddy - dy * ddx);
+        rmin = std::min(rmin, r);
+    }
+    std::printf("bezier: %.5f mm (exact %.5f), min radius %.3f mm (exact %.3f)\n",
+                sh.len_q8 / 256000.0, len, sh.min_radius_um / 1000.0, rmin);
+    EXPECT_NEAR(sh.len_q8 / 256000.0 / len, 1.0, 1e-5);
+    // Sampled at 33 points, the smallest radius is found to within the sampling.
+    EXPECT_NEAR(sh.min_radius_um / 1000.0 / rmin, 1.0, 0.1);
+}

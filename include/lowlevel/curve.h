@@ -22,6 +22,53 @@
 
 namespace ll {
 
+enum : uint8_t { kCurveArc = 1, kCurveBezier = 2 };
+
+/// The axes of a plane: u and v span it, w is its normal (the helix axis). G17: (X, Y, Z),
+/// G18: (Z, X, Y), G19: (Y, Z, X) -- GRBL's order, so that G2 is clockwise seen from +w.
+inline void plane_axes(uint8_t plane, uint8_t ax[3]) {
+    ax[0] = plane == 0 ? 0 : (plane == 1 ? 2 : 1);
+    ax[1] = plane == 0 ? 1 : (plane == 1 ? 0 : 2);
+    ax[2] = plane == 0 ? 2 : (plane == 1 ? 1 : 0);
+}
+
+/// A curve as queued: what the planner keeps per curve and hands to the step generator.
+/// Coordinates are the commanded ones, in the plane's units x1000 (µm for linear axes).
+struct CurveParams {
+    uint8_t kind;        ///< kCurveArc (circle or ellipse) or kCurveBezier
+    uint8_t plane;       ///< 0 = G17, 1 = G18, 2 = G19 (see plane_axes)
+    uint8_t clockwise;   ///< arcs: 1 for G2 / G2.1
+    uint8_t turns;       ///< arcs: extra full turns
+    int32_t start_um[2]; ///< start (u, v)
+    int32_t end_um[2];   ///< end (u, v)
+    int32_t a_um[2];     ///< arc: centre; Bezier: first control point
+    int32_t b_um[2];     ///< arc: semi-axes along u, v (equal for a circle); Bezier: second one
+    uint32_t len_q8;     ///< path length, µm x 256 (set by the planner: curve_shape)
+};
+
+/// What the planner needs of a curve (seed §10.2: the length is what the acceleration and
+/// deceleration distances are measured along).
+struct CurveShape {
+    uint32_t len_q8;        ///< length, µm x 256 (with the normal axis' travel when regulated)
+    uint32_t min_radius_um; ///< smallest radius of curvature (speed limit: v^2 <= a r)
+    int32_t start_dir[3];   ///< unit tangent at the start (u, v, w), Q29
+    int32_t end_dir[3];     ///< unit tangent at the end, Q29
+};
+
+/// Length, curvature and end tangents of a curve whose normal axis travels `dw_um`
+/// (`w_regulated`: w counts in the path length). Returns false for a degenerate curve.
+/// Circles and helices in closed form; ellipses and Beziers by Simpson's rule over 32
+/// intervals per turn / per curve (docs/curves.md: no closed form exists for an ellipse).
+bool curve_shape(const CurveParams& c, int32_t dw_um, bool w_regulated, CurveShape& out);
+
+/// Direction of the point (x, y) seen from an ellipse's centre, normalised in the ellipse's
+/// own scale: the unit vector (cos t, sin t) with (x, y) = (ru cos t, rv sin t) on the curve.
+void ellipse_direction(int32_t x, int32_t y, const uint32_t radii[2], int32_t& c, int32_t& s);
+/// Signed sweep from direction (c0, s0) to (c1, s1), radians x 2^29: in (0, 2 pi] anticlockwise,
+/// [-2 pi, 0) clockwise (a closed arc is a full turn), plus `turns` full turns.
+int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clockwise,
+                      uint8_t turns);
+
 /// Walks one curve in the plane (u, v), with an optional third axis w moving linearly along it
 /// (a helix). Coordinates are ticks; `_q8` values are ticks x 256.
 class CurveWalker {
