@@ -286,8 +286,10 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
     return true;
 }
 
-void CurveWalker::next_delta_q16(int32_t d[3]) const {
+uint16_t CurveWalker::peek(int32_t d[3]) {
+    while (left_ == 0 && kind_ != 0 && pieces_ != 0) next_piece();
     for (uint8_t a = 0; a < 3; ++a) d[a] = static_cast<int32_t>(d1_[a] >> 24);
+    return left_;
 }
 
 namespace {

@@ -236,7 +236,7 @@ void settings_changed() {
     Motion& m = mo();
     machine_build(m.machine, g_settings);
     m.planner.configure(&m.machine);
-    m.gen.configure(&m.machine.lengths, m.machine.min_period);
+    m.gen.configure(&m.machine.lengths, m.machine.min_period, m.machine.um_q8_per_step);
     hal::StepperConfig cfg;
     cfg.pulse_cycles = static_cast<uint16_t>(g_settings.pulse_us * (kCpuHz / 1000000));
     cfg.step_invert = g_settings.step_invert;

@@ -193,6 +193,7 @@ MoveSpec Planner::spec_of_first() const {
     s.v_nominal2 = nominal2(b);
     s.v_exit2 = exit2_of_first();
     s.group = b.group;
+    s.curve = nullptr;
     return s;
 }
 

@@ -25,13 +25,17 @@ uint32_t max3(uint32_t a, uint32_t b, uint32_t c) {
 
 } // namespace
 
-void StepGen::configure(const StepLengths* lengths, uint16_t min_period) {
+void StepGen::configure(const StepLengths* lengths, uint16_t min_period,
+                        const Num* um_q8_per_step) {
     lengths_ = lengths;
     min_period_ = min_period;
+    um_q8_per_step_ = um_q8_per_step;
 }
 
 bool StepGen::begin(const MoveSpec& spec) {
     pushed_position(start_); // the previous move is complete: start from its end
+    curve_ = nullptr;
+    if (spec.curve) return begin_curve(spec);
     if (!line_setup(line_, spec.delta)) {
         line_.m = 0;
         return false;
@@ -107,8 +111,63 @@ uint32_t StepGen::a_of(uint32_t v2) const {
     return a > kMaxA ? kMaxA : a;
 }
 
+bool StepGen::begin_curve(const MoveSpec& spec) {
+    const CurveParams& c = *spec.curve;
+    if (!um_q8_per_step_) return false;
+    line_.m = 0;
+    plane_axes(c.plane, curve_axes_);
+    // Machine positions (ticks) and commanded points of the plane (ticks x 256) for the walker:
+    // µm x steps per µm, i.e. x 256 / (µm x 256 per step).
+    CurveWalker::Ends e;
+    int32_t centre[2], other[2];
+    uint32_t radii[2];
+    for (uint8_t k = 0; k < 3; ++k) {
+        uint8_t a = curve_axes_[k];
+        e.start[k] = start_[a];
+        e.end[k] = start_[a] + spec.delta[a];
+    }
+    for (uint8_t k = 0; k < 2; ++k) {
+        Num per_um(65536);
+        per_um.div(um_q8_per_step_[curve_axes_[k]]); // ticks x 256 per µm
+        auto to_q8 = [&](int32_t um) {
+            int32_t v = static_cast<int32_t>(per_um.of(abs32(um)));
+            return um < 0 ? -v : v;
+        };
+        e.start_q8[k] = to_q8(c.start_um[k]);
+        e.end_q8[k] = to_q8(c.end_um[k]);
+        centre[k] = to_q8(c.a_um[k]);
+        other[k] = to_q8(c.b_um[k]);
+        radii[k] = static_cast<uint32_t>(abs32(other[k]));
+    }
+    bool ok = c.kind == kCurveArc ? walker_.arc(e, centre, radii, c.clockwise != 0, c.turns)
+                                  : walker_.bezier(e, centre, other);
+    if (!ok) return false;
+    curve_ = &c;
+    len_q8_ = spec.len_q8;
+    accel_ = spec.accel;
+    feed_ = spec.feed;
+    v_nominal2_ = spec.v_nominal2;
+    v_exit2_ = spec.v_exit2;
+    // The profile's reference axis is a virtual one with 1000 ticks per mm (µm) along the path.
+    ref_um_ = len_q8_ >> 8;
+    if (ref_um_ == 0) ref_um_ = 1;
+    x_q8_ = 0;
+    uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
+    have_handover_ = false;
+    origin_ = 0;
+    prepare_profile(entry, spec.v_exit2, ref_um_);
+    if (holding_) {
+        a_hold_ = prof_.a_entry;
+        x2_hold_ = 0;
+    }
+    active_ = true;
+    stopped_ = false;
+    seg_len_ = 1;
+    return true;
+}
+
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
-    const uint32_t d1 = line_.dist[0];
+    const uint32_t d1 = ref_len();
     // Fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
     // l = v^2 rho / (2 a), rho = 1000 d_1 / len_um = 256000 d_1 / len_q8 ticks per mm.
     Num phi(128000);
@@ -140,7 +199,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
 
 void StepGen::set_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
-    if (2 * (cursor_.x1 - origin_) >= x2_decel_) return; // end deceleration already begun
+    if (2 * (progress() - origin_) >= x2_decel_) return; // end deceleration already begun
     v_exit2_ = v_exit2;
     prof_.a_exit = a_of(v_exit2);
     if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
@@ -152,7 +211,7 @@ void StepGen::hold() {
     holding_ = true;
     if (active_) {
         a_hold_ = a_last_;
-        x2_hold_ = 2 * (cursor_.x1 - origin_);
+        x2_hold_ = 2 * (progress() - origin_);
     }
 }
 
@@ -161,8 +220,8 @@ void StepGen::resume(uint32_t v_exit2) {
     if (!stopped_) return;
     stopped_ = false;
     v_exit2_ = v_exit2;
-    origin_ = cursor_.x1;
-    prepare_profile(0, v_exit2, line_.dist[0] - cursor_.x1);
+    origin_ = progress();
+    prepare_profile(0, v_exit2, ref_len() - origin_);
     seg_len_ = 1;
 }
 
@@ -173,6 +232,10 @@ uint32_t StepGen::speed2() const {
 
 void StepGen::pushed_position(int32_t out[kAxes]) const {
     for (uint8_t a = 0; a < kAxes; ++a) out[a] = start_[a];
+    if (curve_) {
+        for (uint8_t k = 0; k < 3; ++k) out[curve_axes_[k]] = walker_.pos[k];
+        return;
+    }
     for (uint8_t j = 0; j < line_.m; ++j) {
         uint8_t a = line_.axis[j];
         int32_t p = static_cast<int32_t>(cursor_.pos[j]);
@@ -183,6 +246,7 @@ void StepGen::pushed_position(int32_t out[kAxes]) const {
 void StepGen::set_position(const int32_t steps[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) start_[a] = steps[a];
     line_.m = 0;
+    curve_ = nullptr;
     active_ = false;
 }
 
@@ -209,7 +273,7 @@ void StepGen::clear_queue_time() {
     seen_head_ = 0;
 }
 
-void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8) {
+void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8) {
     uint32_t period = period_q8 > 0xFFFFFF7Ful ? 0xFFFFFFul : (period_q8 + 128) >> 8;
     if (period < min_period_) {
         period = min_period_;
@@ -218,7 +282,6 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8
 #endif
     }
     if (period > kMaxPeriodCycles) period = kMaxPeriodCycles;
-    const uint8_t dirs = line_.dirs;
     if (period <= 0xFFFF) {
         uint32_t units = (period * count) >> 10; // < 2^14
         slot_time_[q.tail] = units > 255 ? 255 : static_cast<uint8_t>(units);
@@ -246,8 +309,58 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8
     }
 }
 
-uint8_t StepGen::fill(RunQueue& q) {
-    uint8_t pushed_before = q.used();
+bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
+    uint32_t a = profile_a(prof_, x2);
+    if (holding_) {
+        uint32_t dec = shl_sat(x2 - x2_hold_, static_cast<uint8_t>(prof_.log_s - 1));
+        if (dec >= a_hold_) {
+            stopped_ = true; // the speed reaches zero before this point
+            return false;
+        }
+        uint32_t ah = a_hold_ - dec;
+        if (ah < a) a = ah;
+    }
+    a_last_ = a;
+    if (a == prof_.a_cruise && !holding_) {
+        delta = prof_.cruise;
+        return true;
+    }
+    bool changed = !root_valid_;
+    if (!root_valid_) {
+        root_.reset(a);
+        root_valid_ = true;
+    } else {
+        changed = root_.seek(a);
+    }
+    if (changed) {
+        delta_root_ = prof_.d_num / (root_.r != 0 ? root_.r : 1);
+#if LL_STATS
+        ++stats.divisions;
+#endif
+    }
+    delta = delta_root_;
+    if (a <= prof_.a_cruise && delta < prof_.cruise) delta = prof_.cruise;
+    return true;
+}
+
+uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest) {
+    uint8_t next = 1;
+    if (longest <= 0xFFFF00ul) {
+        const uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8;
+        while (next < kMaxSegmentTicks && delta < target / next) {
+            next = static_cast<uint8_t>(next << 1);
+        }
+    }
+    return next;
+}
+
+void StepGen::finish_move() {
+    active_ = false;
+    have_handover_ = true;
+    handover_v2_ = holding_ ? speed2() : v_exit2_;
+}
+
+void StepGen::fill_line(RunQueue& q) {
     while (active_ && !stopped_) {
         // Room for the worst case of one segment: m runs, each possibly split in two; and no
         // more than the horizon committed ahead of the interrupt.
@@ -255,68 +368,87 @@ uint8_t StepGen::fill(RunQueue& q) {
         if (queued_cycles(q) >= kHorizonCycles) break;
         uint32_t left = line_.dist[0] - cursor_.x1;
         uint8_t len = left < seg_len_ ? static_cast<uint8_t>(left) : seg_len_;
-        uint32_t x2 = 2 * (cursor_.x1 - origin_) + len; // segment midpoint, half ticks
-        uint32_t a = profile_a(prof_, x2);
-        if (holding_) {
-            uint32_t dec = shl_sat(x2 - x2_hold_, static_cast<uint8_t>(prof_.log_s - 1));
-            if (dec >= a_hold_) {
-                stopped_ = true; // the speed reaches zero before this segment's midpoint
-                break;
-            }
-            uint32_t ah = a_hold_ - dec;
-            if (ah < a) a = ah;
-        }
-        a_last_ = a;
         uint32_t delta;
-        if (a == prof_.a_cruise && !holding_) {
-            delta = prof_.cruise;
-        } else {
-            bool changed = !root_valid_;
-            if (!root_valid_) {
-                root_.reset(a);
-                root_valid_ = true;
-            } else {
-                changed = root_.seek(a);
-            }
-            if (changed) {
-                delta_root_ = prof_.d_num / (root_.r != 0 ? root_.r : 1);
-#if LL_STATS
-                ++stats.divisions;
-#endif
-            }
-            delta = delta_root_;
-            if (a <= prof_.a_cruise && delta < prof_.cruise) delta = prof_.cruise;
-        }
-
+        if (!delta_at(2 * (cursor_.x1 - origin_) + len, delta)) break; // segment midpoint
         uint8_t e[kAxes];
         line_advance(line_, cursor_, len, e);
         MicroRun runs[kAxes];
         uint8_t n = micro_split(e, line_.m, runs);
         for (uint8_t i = 0; i < n; ++i) {
             uint8_t idx = static_cast<uint8_t>(runs[i].set >> 1);
-            emit(q, k_mask_[idx], runs[i].count, mul_shr(delta, k_[idx], 20));
+            emit(q, k_mask_[idx], line_.dirs, runs[i].count, mul_shr(delta, k_[idx], 20));
         }
 #if LL_STATS
         ++stats.segments;
 #endif
+        seg_len_ = next_segment(delta, mul_shr(delta, kmax_, 20));
+        if (cursor_.x1 == line_.dist[0]) finish_move();
+    }
+}
 
-        // Next segment: the shortest power of two lasting kSegmentCycles at this speed, and a
-        // single tick whenever a period needs idle waits (so a segment never needs more than
-        // two queue slots per run).
-        uint8_t next = 1;
-        if (mul_shr(delta, kmax_, 20) <= 0xFFFF00ul) {
-            const uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8;
-            while (next < kMaxSegmentTicks && delta < target / next) {
-                next = static_cast<uint8_t>(next << 1);
+void StepGen::fill_curve(RunQueue& q) {
+    while (active_ && !stopped_) {
+        // Worst case of one segment: every sample its own run, each possibly split in two.
+        if (q.free_slots() < 2 * kMaxSegmentTicks + 2) break;
+        if (queued_cycles(q) >= kHorizonCycles) break;
+        // The chord of the next sample sets the time of every sample of the segment (the
+        // segment never crosses into the next piece, whose samples may be twice as long).
+        int32_t d[3];
+        uint16_t left = walker_.peek(d);
+        Num sum{};
+        for (uint8_t k = 0; k < 3; ++k) {
+            Num v(abs32(d[k]));
+            v.mul(v).mul(lengths_->inv2[curve_axes_[k]]);
+            sum.add(v);
+        }
+        // mm over 2^16 -> µm x 256
+        uint32_t chord_q8 = sum.sqrt().mul(256000).shift(-16).u32();
+        if (chord_q8 == 0) chord_q8 = 1;
+        uint8_t n = seg_len_;
+        if (left != 0 && left < n) n = static_cast<uint8_t>(left);
+        uint32_t mid = x_q8_ + chord_q8 * n / 2;
+        uint32_t delta;
+        if (!delta_at(2 * ((mid >> 8) - origin_), delta)) break;
+        // Delta (cycles x 256 per µm) x chord (µm x 256) / 256.
+        uint32_t period_q8 = mul_shr(delta, chord_q8, 8);
+        // Samples of the same axes and directions make one run.
+        uint8_t run_steps = 0, run_dirs = 0, run_count = 0;
+        uint8_t i = 0;
+        for (; i < n; ++i) {
+            uint8_t moved, neg;
+            if (!walker_.next(moved, neg)) break;
+            uint8_t steps = 0, dirs = 0;
+            for (uint8_t k = 0; k < 3; ++k) {
+                uint8_t bit = static_cast<uint8_t>(1u << curve_axes_[k]);
+                if (moved & (1u << k)) steps = static_cast<uint8_t>(steps | bit);
+                if (neg & (1u << k)) dirs = static_cast<uint8_t>(dirs | bit);
             }
+            if (run_count != 0 && (steps != run_steps || (steps && dirs != run_dirs))) {
+                emit(q, run_steps, run_dirs, run_count, period_q8);
+                run_count = 0;
+            }
+            if (run_count == 0) {
+                run_steps = steps;
+                run_dirs = steps ? dirs : run_dirs;
+            }
+            ++run_count;
         }
-        seg_len_ = next;
+        if (run_count != 0) emit(q, run_steps, run_dirs, run_count, period_q8);
+        x_q8_ += chord_q8 * i;
+#if LL_STATS
+        ++stats.segments;
+#endif
+        seg_len_ = next_segment(period_q8 < 1 ? 1 : period_q8, period_q8);
+        if (walker_.done()) finish_move();
+    }
+}
 
-        if (cursor_.x1 == line_.dist[0]) {
-            active_ = false;
-            have_handover_ = true;
-            handover_v2_ = holding_ ? speed2() : v_exit2_;
-        }
+uint8_t StepGen::fill(RunQueue& q) {
+    uint8_t pushed_before = q.used();
+    if (curve_) {
+        fill_curve(q);
+    } else {
+        fill_line(q);
     }
     return static_cast<uint8_t>(q.used() - pushed_before);
 }

@@ -96,12 +96,12 @@ class CurveWalker {
     /// no axis. Returns false once the curve is complete (the position is then `end`).
     bool next(uint8_t& moved, uint8_t& neg);
 
-    /// Displacement of the sample that next() will produce, ticks x 2^16 per axis: its chord,
-    /// from which the step generator times it.
-    void next_delta_q16(int32_t d[3]) const;
-
-    /// Sum over the remaining pieces of nothing: samples left in the current piece (tests).
-    uint16_t samples_left() const { return left_; }
+    /// Makes the next sample's piece current (starting the next piece when needed) and gives
+    /// that sample's displacement, ticks x 2^16 per axis: its chord, from which the step
+    /// generator times it. Returns the samples left in the piece (0: only the final step to
+    /// the exact end remains, or nothing at all).
+    uint16_t peek(int32_t d[3]);
+    bool done() const { return kind_ == 0; }
 
     int32_t pos[3]; ///< current position, ticks (u, v, w)
 

@@ -11,6 +11,7 @@
 //      (microstep.h), and each run's period is K_P * Delta_1 (seed §5) from the move's K table.
 #pragma once
 
+#include "lowlevel/curve.h"
 #include "lowlevel/fixmath.h"
 #include "lowlevel/line.h"
 #include "lowlevel/microstep.h"
@@ -33,7 +34,7 @@ constexpr uint32_t kHorizonCycles = 64000;
 /// taken at this rate.
 constexpr uint32_t kMaxPeriodCycles = 256ul * 65000;
 
-/// One straight move as the planner hands it over.
+/// One move as the planner hands it over: a straight line, or a curve (seed part IV).
 struct MoveSpec {
     int32_t delta[kAxes]; ///< ticks per machine axis
     uint32_t len_q8;      ///< length of the regulated path (axes of `group`), µm x 256
@@ -43,6 +44,9 @@ struct MoveSpec {
     uint32_t v_nominal2;  ///< nominal speed squared, (mm/min)^2
     uint32_t v_exit2;     ///< exit speed squared, (mm/min)^2
     uint8_t group;        ///< regulated axes G (bit a = machine axis a)
+    /// The curve followed from the current position to `delta` further, or nullptr for a line.
+    /// Must stay valid until the move is fully produced (the planner keeps it in a slot).
+    const CurveParams* curve;
 };
 
 /// Counters for the benchmarks and the docs.
@@ -56,8 +60,10 @@ struct StepGenStats {
 class StepGen {
   public:
     /// `lengths` must outlive the generator; `min_period` is the shortest period the step
-    /// interrupt honours (pulse width + its own margins), CPU cycles.
-    void configure(const StepLengths* lengths, uint16_t min_period);
+    /// interrupt honours (pulse width + its own margins), CPU cycles; `um_q8_per_step` (µm x 256
+    /// per step of each axis, Machine) is needed for curves only.
+    void configure(const StepLengths* lengths, uint16_t min_period,
+                   const Num* um_q8_per_step = nullptr);
 
     /// Prepares a move (seed §7: sort axes, slopes; §5: K table; §4: profile). The entry speed
     /// is `spec.v_entry2` unless a previous move handed over its actual exit speed.
@@ -123,10 +129,26 @@ class StepGen {
     }
 
   private:
+    bool begin_curve(const MoveSpec& spec);
     void prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
-    void emit(RunQueue& q, uint8_t steps, uint8_t count, uint32_t period_q8);
+    void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
+    /// Delta_1 (cycles x 256 per reference unit) at half-unit position x2; false when a hold
+    /// brings the speed to zero before x2.
+    bool delta_at(uint32_t x2, uint32_t& delta);
+    /// Length of the next segment, reference units: the shortest power of two lasting
+    /// kSegmentCycles at `delta`, 1 when `longest` (the largest period, x 256) needs idle waits.
+    static uint8_t next_segment(uint32_t delta, uint32_t longest);
+    void fill_line(RunQueue& q);
+    void fill_curve(RunQueue& q);
+    void finish_move();
+    uint32_t ref_len() const {
+        return curve_ ? ref_um_ : line_.dist[0];
+    }
+    uint32_t progress() const {
+        return curve_ ? (x_q8_ >> 8) : cursor_.x1;
+    }
 
     // Most used first: the ATmega328P addresses the first 64 bytes of an object directly.
     bool active_;
@@ -153,6 +175,13 @@ class StepGen {
     // What remains needed of the MoveSpec after begin().
     uint32_t len_q8_, accel_, feed_, v_nominal2_, v_exit2_;
     const StepLengths* lengths_;
+    const Num* um_q8_per_step_;
+    // The move being produced: a line (line_, cursor_, K table) or a curve (walker_).
+    const CurveParams* curve_;
+    uint32_t ref_um_;       ///< curve: its length, µm (the profile's reference length)
+    uint32_t x_q8_;         ///< curve: distance travelled, µm x 256
+    uint8_t curve_axes_[3]; ///< curve: machine axes u, v, w
+    CurveWalker walker_;
     LineGeometry line_;
     LineCursor cursor_;
     int32_t start_[kAxes]; ///< position where the current (or last) move started, steps
