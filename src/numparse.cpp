@@ -10,58 +10,56 @@ constexpr uint32_t kInt32Max = 0x7FFFFFFFu;
 
 bool finish(bool negative, uint32_t magnitude, int32_t& out) {
     if (magnitude > kInt32Max) return false;
-    out = negative ? -static_cast<int32_t>(magnitude) : static_cast<int32_t>(magnitude);
+    out = static_cast<int32_t>(negative ? 0u - magnitude : magnitude);
     return true;
 }
 } // namespace
 
 bool parse(const char* s, uint8_t& pos, Decimal& out) {
-    uint8_t i = pos;
-    out.ipart = 0;
-    out.frac = 0;
-    out.sub = 0;
-    out.flags = 0;
-    bool negative = false;
-    if (s[i] == '-') {
-        negative = true;
-        ++i;
-    } else if (s[i] == '+') {
-        ++i;
-    }
+    const char* p = s + pos;
+    uint8_t flags = 0;
+    if (*p == '-') flags = Decimal::kNegative;
+    if (*p == '-' || *p == '+') ++p;
+    uint32_t ipart = 0;
+    uint16_t frac = 0;
+    uint8_t sub = 0;
+    // Digits after the point seen so far, counted up to 6; 0xFF before the point.
+    uint8_t decimals = 0xFF;
     bool any_digit = false;
-    uint8_t decimals = 0; // digits seen after the point, counted up to 6
-    bool point = false;
-    for (;; ++i) {
-        char c = s[i];
-        if (c == '.' && !point) {
-            point = true;
+    for (;; ++p) {
+        uint8_t d = static_cast<uint8_t>(*p - '0');
+        if (d > 9) {
+            if (*p != '.' || decimals != 0xFF) break;
+            decimals = 0;
             continue;
         }
-        uint8_t d = static_cast<uint8_t>(c - '0');
-        if (d > 9) break;
         any_digit = true;
-        if (!point) {
-            if (out.ipart > kMaxIpart / 10) return false;        // a 10th significant digit
-            out.ipart = (out.ipart << 3) + (out.ipart << 1) + d; // x10 without a call
+        if (decimals == 0xFF) {
+            if (ipart > kMaxIpart / 10) return false; // a 10th significant digit
+            ipart = (ipart << 3) + (ipart << 1) + d;  // x10 without a call
+        } else if (decimals < 3) {
+            frac = static_cast<uint16_t>(frac * 10u + d);
+        } else if (decimals < 5) {
+            sub = static_cast<uint8_t>(sub * 10u + d);
         } else {
-            if (decimals < 3) {
-                out.frac = static_cast<uint16_t>(out.frac * 10 + d);
-            } else if (decimals < 5) {
-                out.sub = static_cast<uint8_t>(out.sub * 10 + d);
-            } else {
-                if (decimals == 5 && d >= 5) out.flags |= Decimal::kRound6;
-                if (d != 0) out.flags |= Decimal::kInexact;
-            }
-            if (decimals < 6) ++decimals;
+            if (decimals == 5 && d >= 5) flags |= Decimal::kRound6;
+            if (d != 0) flags |= Decimal::kInexact;
         }
+        if (decimals < 6) ++decimals;
     }
     if (!any_digit) return false;
     // Missing decimals are zeros: "1.5" is 1 and 500 thousandths, "0.0001" has sub = 10.
-    for (uint8_t k = decimals; k < 3; ++k) out.frac = static_cast<uint16_t>(out.frac * 10);
-    if (decimals == 4) out.sub = static_cast<uint8_t>(out.sub * 10);
-    if (negative && (out.ipart | out.frac | out.sub | (out.flags & Decimal::kInexact)) != 0)
-        out.flags |= Decimal::kNegative;
-    pos = i;
+    if (decimals != 0xFF) {
+        for (; decimals < 3; ++decimals) frac = static_cast<uint16_t>(frac * 10u);
+        if (decimals == 4) sub = static_cast<uint8_t>(sub * 10u);
+    }
+    // "-0" is not negative.
+    if (ipart == 0 && frac == 0 && sub == 0 && !(flags & Decimal::kInexact)) flags = 0;
+    out.ipart = ipart;
+    out.frac = frac;
+    out.sub = sub;
+    out.flags = flags;
+    pos = static_cast<uint8_t>(p - s);
     return true;
 }
 
@@ -86,57 +84,47 @@ bool to_uint(const Decimal& d, uint32_t max, uint32_t& out) {
     return true;
 }
 
-// 16x16 -> 32 bits. Kept out of line so that the compiler sees 16-bit operands and calls the
-// chip's short widening routine (__umulhisi3) instead of a full 32x32 multiplication.
-__attribute__((noinline)) uint32_t mul16(uint16_t a, uint16_t b) {
-    return static_cast<uint32_t>(a) * b;
-}
-
-void mul64(uint32_t a, uint32_t b, uint32_t& hi, uint32_t& lo) {
-    uint16_t al = static_cast<uint16_t>(a), ah = static_cast<uint16_t>(a >> 16);
-    uint16_t bl = static_cast<uint16_t>(b), bh = static_cast<uint16_t>(b >> 16);
-    uint32_t l = mul16(al, bl);
-    uint32_t mid1 = mul16(al, bh);
-    uint32_t mid2 = mul16(ah, bl);
-    uint32_t h = mul16(ah, bh);
-    uint32_t mid = mid1 + mid2;
-    if (mid < mid1) h += 0x10000u; // the carry out of the middle sum is worth 2^48
-    uint32_t t = l + (mid << 16);
-    if (t < l) ++h;
-    lo = t;
-    hi = h + (mid >> 16);
-}
-
-uint32_t div64(uint32_t hi, uint32_t lo, uint32_t c, uint32_t& rem) {
-    // Restoring division, one quotient bit per turn; r < c < 2^31, so r << 1 never overflows.
-    uint32_t r = hi;
-    for (uint8_t k = 0; k < 32; ++k) {
-        r = (r << 1) | (lo >> 31);
-        lo <<= 1;
-        if (r >= c) {
-            r -= c;
-            lo |= 1u;
-        }
-    }
-    rem = r;
-    return lo;
-}
-
 bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out) {
     bool negative = a < 0;
     uint32_t m = negative ? 0u - static_cast<uint32_t>(a) : static_cast<uint32_t>(a);
-    uint32_t hi, lo;
-    mul64(m, b, hi, lo);
+    // The halves of the product through a union (both targets are little-endian): 64-bit
+    // shifts would be library calls on the chip.
+    union {
+        uint64_t v;
+        uint32_t w[2];
+    } p;
+    static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "w[0] is the low half");
+    p.v = static_cast<uint64_t>(m) * b;
+    uint32_t q = p.w[0], r = p.w[1];
     // + c/2: half away from zero on the magnitude.
-    uint32_t t = lo + (c >> 1);
-    if (t < lo) ++hi;
-    lo = t;
-    uint32_t rem;
-    if (hi >= c || !finish(negative, div64(hi, lo, c, rem), out)) {
-        out = negative ? -static_cast<int32_t>(kInt32Max) - 1 : static_cast<int32_t>(kInt32Max);
-        return false;
+    uint32_t half = c >> 1;
+    q += half;
+    if (q < half) ++r;
+    if (r < c) {
+        // Restoring division of r:q by c, one quotient bit per turn; the quotient bits shift
+        // into q from the right. r < c < 2^31, so r << 1 never overflows. While r < c / 256, the
+        // next 8 quotient bits are zero: take those a byte at a time.
+        uint8_t k = 32;
+        uint32_t c8 = c >> 8;
+        while (k > 8 && r < c8) {
+            r = (r << 8) | (q >> 24);
+            q <<= 8;
+            k = static_cast<uint8_t>(k - 8);
+        }
+        do {
+            bool carry = static_cast<int32_t>(q) < 0;
+            q <<= 1;
+            r <<= 1;
+            if (carry) r |= 1u;
+            if (r >= c) {
+                r -= c;
+                q |= 1u;
+            }
+        } while (--k != 0);
+        if (finish(negative, q, out)) return true;
     }
-    return true;
+    out = static_cast<int32_t>(negative ? 0x80000000u : kInt32Max);
+    return false;
 }
 
 } // namespace num

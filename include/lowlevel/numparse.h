@@ -44,15 +44,11 @@ bool inch_to_milli(const Decimal& d, int32_t& out);
 /// The value as an integer in [0, max]. False when negative, not integral or above max.
 bool to_uint(const Decimal& d, uint32_t max, uint32_t& out);
 
-/// round_half_away_from_zero(a * b / c), exactly, with 32-bit pieces only (no 64-bit division
-/// on the chip: a 32-step restoring division). Preconditions: 0 < c < 2^31. Returns false (and
-/// saturates `out`) when the result does not fit in an int32.
+/// round_half_away_from_zero(a * b / c), exactly: one 32x32->64 product and a restoring
+/// division that skips leading zero quotient bytes (no 64-bit library division on the chip).
+/// Preconditions: 0 < c < 2^31. Returns false (and saturates `out`) when the result does not
+/// fit in an int32 (INT32_MIN included: only magnitudes up to INT32_MAX are produced).
 bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out);
-
-/// The 64-bit product a * b as two halves.
-void mul64(uint32_t a, uint32_t b, uint32_t& hi, uint32_t& lo);
-/// (hi:lo) / c and its remainder. Preconditions: 0 < c < 2^31 and hi < c (the quotient fits).
-uint32_t div64(uint32_t hi, uint32_t lo, uint32_t c, uint32_t& rem);
 
 } // namespace num
 } // namespace ll
