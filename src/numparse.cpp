@@ -63,18 +63,18 @@ bool parse(const char* s, uint8_t& pos, Decimal& out) {
     return true;
 }
 
-bool to_milli(const Decimal& d, int32_t& out) {
-    if (d.ipart > kInt32Max / 1000) return false;
-    uint32_t m = d.ipart * 1000u + d.frac + (d.sub >= 50 ? 1u : 0u);
-    return finish(d.negative(), m, out);
-}
-
-bool inch_to_milli(const Decimal& d, int32_t& out) {
-    // 25400 per inch; the five decimals are 1e-5 in = 0.254 units of the result.
-    if (d.ipart > kInt32Max / 25400) return false;
-    uint32_t frac5 =
-        static_cast<uint32_t>(d.frac) * 100u + d.sub + ((d.flags & Decimal::kRound6) ? 1u : 0u);
-    uint32_t m = d.ipart * 25400u + (frac5 * 254u + 500u) / 1000u;
+bool length_to_milli(const Decimal& d, bool inches, int32_t& out) {
+    uint32_t m;
+    if (inches) {
+        // 25400 per inch; the five decimals are 1e-5 in = 0.254 units of the result.
+        if (d.ipart > kInt32Max / 25400) return false;
+        uint32_t frac5 =
+            static_cast<uint32_t>(d.frac) * 100u + d.sub + ((d.flags & Decimal::kRound6) ? 1u : 0u);
+        m = d.ipart * 25400u + (frac5 * 254u + 500u) / 1000u;
+    } else {
+        if (d.ipart > kInt32Max / 1000) return false;
+        m = d.ipart * 1000u + d.frac + (d.sub >= 50 ? 1u : 0u);
+    }
     return finish(d.negative(), m, out);
 }
 
@@ -82,6 +82,72 @@ bool to_uint(const Decimal& d, uint32_t max, uint32_t& out) {
     if (d.negative() || !d.integral() || d.ipart > max) return false;
     out = d.ipart;
     return true;
+}
+
+// (r:q) / c for r < c < 2^31: the quotient replaces q, the remainder r. A restoring division,
+// one quotient bit per turn, the quotient bits shifting into q from the right (r << 1 never
+// overflows as r < 2^31). While r < c / 256, the next 8 quotient bits are zero: those are
+// taken a byte at a time (a position in um times steps/um usually needs 12 to 20 bit turns).
+// The chip gets the same algorithm in assembly: 19 cycles a bit instead of 40.
+inline void divide(uint32_t& r, uint32_t& q, uint32_t c) {
+#ifdef __AVR__
+    uint8_t k;
+    asm("ldi %[k], 32\n\t"
+        "0: cpi %[k], 9\n\t" // bytes: while k > 8 and r < c >> 8
+        "brlo 1f\n\t"
+        "cp %A[r], %B[c]\n\t"
+        "cpc %B[r], %C[c]\n\t"
+        "cpc %C[r], %D[c]\n\t"
+        "cpc %D[r], __zero_reg__\n\t"
+        "brsh 1f\n\t"
+        "mov %D[r], %C[r]\n\t"
+        "mov %C[r], %B[r]\n\t"
+        "mov %B[r], %A[r]\n\t"
+        "mov %A[r], %D[q]\n\t"
+        "mov %D[q], %C[q]\n\t"
+        "mov %C[q], %B[q]\n\t"
+        "mov %B[q], %A[q]\n\t"
+        "clr %A[q]\n\t"
+        "subi %[k], 8\n\t"
+        "rjmp 0b\n\t"
+        "1: lsl %A[q]\n\t" // bits
+        "rol %B[q]\n\t"
+        "rol %C[q]\n\t"
+        "rol %D[q]\n\t"
+        "rol %A[r]\n\t"
+        "rol %B[r]\n\t"
+        "rol %C[r]\n\t"
+        "rol %D[r]\n\t"
+        "cp %A[r], %A[c]\n\t"
+        "cpc %B[r], %B[c]\n\t"
+        "cpc %C[r], %C[c]\n\t"
+        "cpc %D[r], %D[c]\n\t"
+        "brlo 2f\n\t"
+        "sub %A[r], %A[c]\n\t"
+        "sbc %B[r], %B[c]\n\t"
+        "sbc %C[r], %C[c]\n\t"
+        "sbc %D[r], %D[c]\n\t"
+        "ori %A[q], 1\n\t"
+        "2: dec %[k]\n\t"
+        "brne 1b"
+        : [r] "+r"(r), [q] "+d"(q), [k] "=&d"(k)
+        : [c] "r"(c));
+#else
+    uint8_t k = 32;
+    while (k > 8 && r < (c >> 8)) {
+        r = (r << 8) | (q >> 24);
+        q <<= 8;
+        k = static_cast<uint8_t>(k - 8);
+    }
+    do {
+        r = (r << 1) | (q >> 31);
+        q <<= 1;
+        if (r >= c) {
+            r -= c;
+            q |= 1u;
+        }
+    } while (--k != 0);
+#endif
 }
 
 bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out) {
@@ -101,26 +167,7 @@ bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out) {
     q += half;
     if (q < half) ++r;
     if (r < c) {
-        // Restoring division of r:q by c, one quotient bit per turn; the quotient bits shift
-        // into q from the right. r < c < 2^31, so r << 1 never overflows. While r < c / 256, the
-        // next 8 quotient bits are zero: take those a byte at a time.
-        uint8_t k = 32;
-        uint32_t c8 = c >> 8;
-        while (k > 8 && r < c8) {
-            r = (r << 8) | (q >> 24);
-            q <<= 8;
-            k = static_cast<uint8_t>(k - 8);
-        }
-        do {
-            bool carry = static_cast<int32_t>(q) < 0;
-            q <<= 1;
-            r <<= 1;
-            if (carry) r |= 1u;
-            if (r >= c) {
-                r -= c;
-                q |= 1u;
-            }
-        } while (--k != 0);
+        divide(r, q, c);
         if (finish(negative, q, out)) return true;
     }
     out = static_cast<int32_t>(negative ? 0x80000000u : kInt32Max);

@@ -37,10 +37,16 @@ struct Decimal {
 /// part has more than 9 digits.
 bool parse(const char* s, uint8_t& pos, Decimal& out);
 
+/// inch_to_milli() when `inches`, else to_milli(): a length or feed in the units of a block.
+bool length_to_milli(const Decimal& d, bool inches, int32_t& out);
 /// value x1000, half away from zero. False when |value x1000| would exceed INT32_MAX.
-bool to_milli(const Decimal& d, int32_t& out);
+inline bool to_milli(const Decimal& d, int32_t& out) {
+    return length_to_milli(d, false, out);
+}
 /// value x25400 (inches to um), see above. False when the result would exceed INT32_MAX.
-bool inch_to_milli(const Decimal& d, int32_t& out);
+inline bool inch_to_milli(const Decimal& d, int32_t& out) {
+    return length_to_milli(d, true, out);
+}
 /// The value as an integer in [0, max]. False when negative, not integral or above max.
 bool to_uint(const Decimal& d, uint32_t max, uint32_t& out);
 
