@@ -79,42 +79,43 @@ struct Command {
 };
 constexpr uint8_t dec1 = 1 << 4; // group byte of a command with decimal 1
 
+// In the order of their frequency in CAM output: the search stops at the first match.
 const Command kCommands[] LL_PROGMEM = {
-    {0, kGroupMotion, uint8_t(Motion::Seek) | kUsesAxes},
     {1, kGroupMotion, uint8_t(Motion::Linear) | kUsesAxes},
-    {4, kGroupNonModal, kDwellCmd},
-    {10, kGroupNonModal, kSetCoordData | kUsesAxes},
+    {0, kGroupMotion, uint8_t(Motion::Seek) | kUsesAxes},
+    {90, kGroupDistance, 0 | kStrict}, // G90.1: 20
+    {91, kGroupDistance, 1 | kStrict},
+    {21, kGroupUnits, 0},
+    {20, kGroupUnits, 1},
     {17, kGroupPlane, 0},
+    {94, kGroupFeedMode, 0},
+    {54, kGroupCoord, 0},
+    {kM | 3, kGroupSpindle, 3},
+    {kM | 5, kGroupSpindle, 5},
+    {kM | 8, kGroupCoolant, 8},
+    {kM | 9, kGroupCoolant, 9},
+    {kM | 30, kGroupFlow, kFlowEnd},
+    {kM | 2, kGroupFlow, kFlowEnd},
+    {4, kGroupNonModal, kDwellCmd},
+    {92, kGroupNonModal, kSetOffset | kUsesAxes | kStrict},
+    {53, kGroupNonModal, kAbsoluteOverride},
+    {80, kGroupMotion, uint8_t(Motion::None)},
     {18, kGroupPlane, 1},
     {19, kGroupPlane, 2},
-    {20, kGroupUnits, 1},
-    {21, kGroupUnits, 0},
     {40, kGroupCutter, 0},     // cutter compensation off: always off
     {49, kGroupToolLength, 0}, // tool length offset off: always off
-    {53, kGroupNonModal, kAbsoluteOverride},
-    {54, kGroupCoord, 0},
+    {61, kGroupPath, kStrict}, // G61.1: 20
+    {kM | 0, kGroupFlow, kFlowPause},
+    {kM | 1, kGroupFlow, kFlowRunning}, // M1 (optional stop): accepted and ignored, as GRBL
+    {kM | 4, kGroupSpindle, 4},
+    {10, kGroupNonModal, kSetCoordData | kUsesAxes},
+    {92, kGroupNonModal | dec1, kResetOffset | kStrict},
+    {91, kGroupArcDistance | dec1, kStrict}, // G91.1: arc centres incremental, the default
     {55, kGroupCoord, 1},
     {56, kGroupCoord, 2},
     {57, kGroupCoord, 3},
     {58, kGroupCoord, 4},
     {59, kGroupCoord, 5},
-    {61, kGroupPath, kStrict}, // G61.1: 20
-    {80, kGroupMotion, uint8_t(Motion::None)},
-    {90, kGroupDistance, 0 | kStrict}, // G90.1: 20
-    {91, kGroupDistance, 1 | kStrict},
-    {91, kGroupArcDistance | dec1, kStrict}, // G91.1: arc centres incremental, the default
-    {92, kGroupNonModal, kSetOffset | kUsesAxes | kStrict},
-    {92, kGroupNonModal | dec1, kResetOffset | kStrict},
-    {94, kGroupFeedMode, 0},
-    {kM | 0, kGroupFlow, kFlowPause},
-    {kM | 1, kGroupFlow, kFlowRunning}, // M1 (optional stop): accepted and ignored, as GRBL
-    {kM | 2, kGroupFlow, kFlowEnd},
-    {kM | 30, kGroupFlow, kFlowEnd},
-    {kM | 3, kGroupSpindle, 3},
-    {kM | 4, kGroupSpindle, 4},
-    {kM | 5, kGroupSpindle, 5},
-    {kM | 8, kGroupCoolant, 8},
-    {kM | 9, kGroupCoolant, 9},
     // G2 G3 G5 (and G2.1 G3.1 with the decimal) take their place here as motion commands that
     // use the axis words, once their generators exist; until then they are error:20.
 };
@@ -208,9 +209,12 @@ static_assert(offsetof(Block, n) - offsetof(Block, feed) ==
 // static size is visible to the RAM budget.
 struct Work {
     Block b;
-    num::Decimal other; // a G, M, N, L, S, T, I, J, K, Q or R number
-    // The move; for G10 / G92, target_um holds the new offsets (such a block never moves).
-    motion::LineRequest req;
+    union {
+        num::Decimal other; // stage 2: a G, M, N, L, S, T, I, J, K, Q or R number
+        // Stage 3 and 4: the move; for G10 / G92, target_um holds the new offsets (such a
+        // block never moves).
+        motion::LineRequest req;
+    };
 };
 Work w;
 
@@ -232,12 +236,14 @@ uint8_t import_command(Block& b, uint8_t m, const num::Decimal& d) {
     if (d.negative() || d.ipart > 127) return kUnsupportedCommand;
     uint8_t key = static_cast<uint8_t>(d.ipart | m);
     uint8_t dec = tenths(d);
+    if (dec != 0xFF) dec = static_cast<uint8_t>(dec << 4); // as in Command::group
     const Command* c = nullptr;
     bool found = false;
-    for (const Command* e = kCommands; e != kCommands + kCommandCount; ++e) {
+    const Command* e = kCommands;
+    for (uint8_t n = kCommandCount; n != 0; --n, ++e) {
         if (flash_read_byte(&e->key) != key) continue;
         c = e;
-        if ((flash_read_byte(&e->group) >> 4) == dec) {
+        if ((flash_read_byte(&e->group) & 0xF0) == dec) {
             found = true;
             break;
         }
@@ -282,7 +288,7 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
 
 // A length word in the units of the block, to um (or a feed to mm/min x1000).
 bool length(const Block& b, const num::Decimal& d, int32_t& out) {
-    return b.g[kGroupUnits] ? num::inch_to_milli(d, out) : num::to_milli(d, out);
+    return num::length_to_milli(d, b.g[kGroupUnits] != 0, out);
 }
 
 // a + b and a - b; an overflow sets Block::overflow (checked once per line: error:33).
@@ -323,11 +329,17 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
 
     // ---- Stage 1: a block that starts from the current modes.
     Block& b = w.b;
-    memset(&b, 0, offsetof(Block, v));
+    b.g[kGroupNonModal] = kNoNonModal;
     memcpy(&b.g[kGroupMotion], &st.modal, sizeof(Modal));
+    b.g[kGroupFlow] = kFlowRunning;
+    b.axis_command = kAxisNone;
+    b.overflow = 0;
     b.l = 0xFF;
     b.tool = st.tool;
-    memcpy(&b.feed, &st.feed, 2 * sizeof(uint32_t)); // and S; N: 0
+    b.groups = 0;
+    b.words = 0;
+    memcpy(&b.feed, &st.feed, 2 * sizeof(uint32_t)); // and S
+    b.n = 0;
 
     // ---- Stage 2: import every word (letter + number), checking repeats, modal groups and
     // negative F N P S T.
@@ -374,71 +386,77 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     if (b.g[kGroupCoord] != 0) return kUnsupportedCoordSys;
 
     // [19] The axis words in um, then the non-modal commands that use them, or the target.
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        if (!((axes >> a) & 1)) continue;
+    for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
+        if (!(m & 1)) continue;
         int32_t um;
         if (!length(b, b.v[a].d, um)) return kBadNumberFormat;
         b.v[a].um = um;
     }
-    motion::LineRequest& req = w.req;
-    int32_t* target = req.target_um;
-    if (non_modal == kSetCoordData || non_modal == kSetOffset) {
+    // One pass over the axes computes either the new offsets (G10, G92) or the target of a
+    // move: an axis without a word keeps `keep`, an axis with a word gets its value, turned
+    // into a machine position by `op`.
+    enum Op : uint8_t {
+        kAsIs,         // G53 (machine coordinates), G10 L2 (the value is the new G54)
+        kPlusPosition, // G91
+        kPlusOffsets,  // G90: work position + G54 + G92
+        kFromPosition, // G92, G10 L20: position - the other offset - value
+    };
+    bool offsets = non_modal == kSetCoordData || non_modal == kSetOffset;
+    const int32_t* keep = st.position;
+    const int32_t* other = st.g54;
+    uint8_t op = non_modal == kAbsoluteOverride ? kAsIs
+                 : b.g[kGroupDistance]          ? kPlusPosition
+                                                : kPlusOffsets;
+    if (offsets) {
         // G92: the current position becomes the given work position. G10 L20 P0|P1: the same
         // for G54; G10 L2: the given values are the new G54.
         if (axes == 0) return kNoAxisWords;
-        const int32_t* base = st.g92;
-        const int32_t* other = st.g54;
-        bool replace = false;
+        keep = st.g92;
+        op = kFromPosition;
         if (non_modal == kSetCoordData) {
             if (!(b.words & bit(kWordP)) || !(b.words & bit(kWordL))) return kValueWordMissing;
             uint32_t p;
             if (!num::to_uint(b.v[kWordP].d, 1u, p)) return kUnsupportedCoordSys;
             if (b.l != 2 && b.l != 20) return kUnsupportedCommand;
-            replace = b.l == 2;
-            if (replace && (b.words & bit(kWordR))) return kUnsupportedCommand;
+            if (b.l == 2) {
+                if (b.words & bit(kWordR)) return kUnsupportedCommand;
+                op = kAsIs;
+            }
             b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
-            base = st.g54;
+            keep = st.g54;
             other = st.g92;
         }
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            int32_t t = base[a];
-            if ((axes >> a) & 1) {
+    } else if (non_modal == kAbsoluteOverride && motion > Motion::Linear) {
+        return kG53InvalidMotionMode;
+    }
+    motion::LineRequest& req = w.req;
+    if (offsets || b.axis_command == kAxisMotion) {
+        for (uint8_t a = 0, m = axes; a < kAxes; ++a, m >>= 1) {
+            int32_t t = keep[a];
+            int32_t steps = st.position_steps[a];
+            if (m & 1) {
                 t = b.v[a].um;
-                if (!replace) t = sub(sub(st.position[a], other[a]), t);
+                if (op == kPlusPosition) {
+                    t = add(t, st.position[a]);
+                } else if (op == kPlusOffsets) {
+                    t = add(add(t, st.g54[a]), st.g92[a]);
+                } else if (op == kFromPosition) {
+                    t = sub(sub(st.position[a], other[a]), t);
+                }
+                // Always from the absolute target: no rounding error accumulates. One move
+                // travels at most kMaxLineTicks steps per axis (line.h).
+                if (!offsets &&
+                    (!um_to_steps(a, t, steps) ||
+                     abs32(static_cast<int32_t>(static_cast<uint32_t>(steps) -
+                                                static_cast<uint32_t>(st.position_steps[a]))) >
+                         kMaxLineTicks)) {
+                    b.overflow = 1;
+                }
             }
-            target[a] = t;
+            req.target_um[a] = t; // for G10 / G92: the new offsets
+            req.target_steps[a] = steps;
         }
         if (b.overflow) return kInvalidTarget;
-    } else {
-        if (non_modal == kAbsoluteOverride && motion > Motion::Linear) {
-            return kG53InvalidMotionMode;
-        }
-        if (b.axis_command == kAxisMotion) {
-            for (uint8_t a = 0; a < kAxes; ++a) {
-                int32_t t = st.position[a];
-                int32_t steps = st.position_steps[a];
-                if ((axes >> a) & 1) {
-                    t = b.v[a].um;
-                    if (non_modal == kAbsoluteOverride) {
-                        // G53: machine coordinates, whatever the distance mode
-                    } else if (b.g[kGroupDistance]) {
-                        t = add(t, st.position[a]);
-                    } else {
-                        t = add(add(t, st.g54[a]), st.g92[a]);
-                    }
-                    // Always from the absolute target: no rounding error accumulates. One move
-                    // travels at most kMaxLineTicks steps per axis (line.h).
-                    if (b.overflow || !um_to_steps(a, t, steps) ||
-                        abs32(static_cast<int32_t>(static_cast<uint32_t>(steps) -
-                                                   static_cast<uint32_t>(st.position_steps[a]))) >
-                            kMaxLineTicks) {
-                        return kInvalidTarget;
-                    }
-                }
-                target[a] = t;
-                req.target_steps[a] = steps;
-            }
-        }
     }
 
     // [20] Motion modes.
@@ -456,7 +474,6 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     // ---- The block is valid. Conditions to wait for, still without any side effect.
     bool check = (flags & kCheckMode) != 0;
     bool moves = b.axis_command == kAxisMotion;
-    bool offsets = non_modal == kSetCoordData || non_modal == kSetOffset;
     if (!check) {
         if (non_modal == kDwellCmd && !(flags & kDwellDone)) {
             outcome.dwell_ms = static_cast<uint32_t>(dwell_ms);
@@ -474,7 +491,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     memcpy(&st.feed, &b.feed, 3 * sizeof(uint32_t)); // and S, N
     if (offsets) {
         bool g10 = non_modal == kSetCoordData;
-        memcpy(g10 ? st.g54 : st.g92, target, sizeof(st.g54));
+        memcpy(g10 ? st.g54 : st.g92, req.target_um, sizeof(st.g54));
         if (g10 && !check) settings::save_coord(st.g54);
         st.wco_changed = 1;
     } else if (non_modal == kResetOffset) {
