@@ -15,8 +15,7 @@ bool finish(bool negative, uint32_t magnitude, int32_t& out) {
 }
 } // namespace
 
-bool parse(const char* s, uint8_t& pos, Decimal& out) {
-    const char* p = s + pos;
+const char* parse(const char* p, Decimal& out) {
     uint8_t flags = 0;
     if (*p == '-') flags = Decimal::kNegative;
     if (*p == '-' || *p == '+') ++p;
@@ -35,8 +34,8 @@ bool parse(const char* s, uint8_t& pos, Decimal& out) {
         }
         any_digit = true;
         if (decimals == 0xFF) {
-            if (ipart > kMaxIpart / 10) return false; // a 10th significant digit
-            ipart = (ipart << 3) + (ipart << 1) + d;  // x10 without a call
+            if (ipart > kMaxIpart / 10) return nullptr; // a 10th significant digit
+            ipart = (ipart << 3) + (ipart << 1) + d;    // x10 without a call
         } else if (decimals < 3) {
             frac = static_cast<uint16_t>(frac * 10u + d);
         } else if (decimals < 5) {
@@ -47,7 +46,7 @@ bool parse(const char* s, uint8_t& pos, Decimal& out) {
         }
         if (decimals < 6) ++decimals;
     }
-    if (!any_digit) return false;
+    if (!any_digit) return nullptr;
     // Missing decimals are zeros: "1.5" is 1 and 500 thousandths, "0.0001" has sub = 10.
     if (decimals != 0xFF) {
         for (; decimals < 3; ++decimals) frac = static_cast<uint16_t>(frac * 10u);
@@ -59,8 +58,7 @@ bool parse(const char* s, uint8_t& pos, Decimal& out) {
     out.frac = frac;
     out.sub = sub;
     out.flags = flags;
-    pos = static_cast<uint8_t>(p - s);
-    return true;
+    return p;
 }
 
 bool length_to_milli(const Decimal& d, bool inches, int32_t& out) {

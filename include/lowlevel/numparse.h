@@ -32,10 +32,17 @@ struct Decimal {
     bool integral() const { return frac == 0 && sub == 0 && (flags & kInexact) == 0; }
 };
 
-/// Reads `[+|-]digits[.digits]` (at least one digit; GRBL's read_float without its float) from
-/// `s` at `pos` and advances `pos` past it. Returns false when no digit is present or the integer
+/// Reads `[+|-]digits[.digits]` (at least one digit; GRBL's read_float without its float) at
+/// `p`. Returns the character after it, or nullptr when no digit is present or the integer
 /// part has more than 9 digits.
-bool parse(const char* s, uint8_t& pos, Decimal& out);
+const char* parse(const char* p, Decimal& out);
+/// The same with a position in `s`, advanced past the number (unchanged on failure).
+inline bool parse(const char* s, uint8_t& pos, Decimal& out) {
+    const char* end = parse(s + pos, out);
+    if (end == nullptr) return false;
+    pos = static_cast<uint8_t>(end - s);
+    return true;
+}
 
 /// inch_to_milli() when `inches`, else to_milli(): a length or feed in the units of a block.
 bool length_to_milli(const Decimal& d, bool inches, int32_t& out);
