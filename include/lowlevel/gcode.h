@@ -5,6 +5,8 @@
 #pragma once
 
 #include "lowlevel/config.h"
+#include "lowlevel/numparse.h"
+#include "lowlevel/settings.h"
 
 namespace ll {
 namespace gcode {
@@ -100,7 +102,12 @@ void work_offset(int32_t (&um)[kAxes]);
 
 /// round_half_away_from_zero(um * steps_per_unit_milli / 10^6), exact. False (and `steps`
 /// unchanged) when the result does not fit an int32.
-bool um_to_steps(uint8_t axis, int32_t um, int32_t& steps);
+inline bool um_to_steps(uint8_t axis, int32_t um, int32_t& steps) {
+    int32_t s;
+    if (!num::mul_div_round(um, g_settings.axis[axis].steps_per_unit, 1000000u, s)) return false;
+    steps = s;
+    return true;
+}
 
 } // namespace gcode
 } // namespace ll
