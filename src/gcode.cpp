@@ -568,7 +568,7 @@ void report_modes() {
     const Modal& m = g_state.modal;
     static const uint8_t kMotionCode[8] LL_PROGMEM = {0, 1, 2, 3, 2, 3, 5, 80};
     out::str(LL_PSTR("[GC:G"));
-    out::u32(flash_read_byte(&kMotionCode[static_cast<uint8_t>(m.motion)]));
+    out::u8(flash_read_byte(&kMotionCode[static_cast<uint8_t>(m.motion)]));
     out::word('G', static_cast<uint8_t>(54u + m.coord));
     out::word('G', static_cast<uint8_t>(17u + m.plane));
     out::word('G', static_cast<uint8_t>(21u - m.inches));
@@ -590,7 +590,7 @@ void report_offsets() {
     for (uint8_t i = 0; i < sizeof(kCodes); ++i) {
         uint8_t code = flash_read_byte(&kCodes[i]);
         out::str(LL_PSTR("[G"));
-        out::u32(code);
+        out::u8(code);
         out::ch(':');
         out::coords(code == 54 ? g_state.g54 : code == 92 ? g_state.g92 : nullptr);
         out::line(LL_PSTR("]"));

@@ -65,6 +65,10 @@ void u32(uint32_t v) {
     digits(v, 0);
 }
 
+void u8(uint8_t v) {
+    digits(v, 0);
+}
+
 void word(char letter, uint8_t v) {
     ch(' ');
     ch(letter);
@@ -110,7 +114,7 @@ void status(uint8_t code) {
         str(LL_PSTR("ok"));
     } else {
         str(LL_PSTR("error:"));
-        u32(code);
+        u8(code);
     }
     eol();
 }

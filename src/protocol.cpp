@@ -134,9 +134,9 @@ void report_status() {
     out::coords(pos);
     if (g_settings.status_mask & 2u) {
         out::str(LL_PSTR("|Bf:"));
-        out::u32(motion::blocks_free());
+        out::u8(motion::blocks_free());
         out::ch(',');
-        out::u32(hal::serial_rx_free());
+        out::u8(hal::serial_rx_free());
     }
     out::str(LL_PSTR("|FS:"));
     out::rate(motion::current_feed() * 1000u);
@@ -214,9 +214,9 @@ uint8_t system_command() {
         } else {
             out::str(
                 LL_PSTR("[VER:1.1h." LL_BUILD_DATE ":Low Level " LL_VERSION_STRING "]\r\n[OPT:I,"));
-            out::u32(kPlannerSize); // the ring holds kPlannerSize moves
+            out::u8(kPlannerSize); // the ring holds kPlannerSize moves
             out::ch(',');
-            out::u32(p.rx_capacity);
+            out::u8(p.rx_capacity);
             out::line(LL_PSTR("]"));
         }
         return kOk;
@@ -356,7 +356,7 @@ namespace protocol {
 void raise_alarm(uint8_t code) {
     p.alarm = 1;
     out::str(LL_PSTR("ALARM:"));
-    out::u32(code);
+    out::u8(code);
     out::eol();
     if (p.wait != Wait::None) finish(kGcodeLock);
 }

@@ -176,14 +176,14 @@ void report() {
         for (uint8_t a = 0; a < count; ++a) {
             const uint8_t* f = field(row, kind, a);
             out::ch('$');
-            out::u32(static_cast<uint8_t>(first + a));
+            out::u8(static_cast<uint8_t>(first + a));
             out::ch('=');
             if (kind >= kMilli) {
                 int32_t milli;
                 memcpy(&milli, f, sizeof(milli));
                 out::fixed(milli, 3);
             } else {
-                out::u32(*f);
+                out::u8(*f);
             }
             out::eol();
         }

@@ -20,6 +20,8 @@ void eol();
 void line(const FlashChar* s);
 /// An unsigned integer in decimal.
 void u32(uint32_t v);
+/// The same for a byte (a shorter call).
+void u8(uint8_t v);
 /// ' ', `letter`, then `v` in decimal: one word of `$G`.
 void word(char letter, uint8_t v);
 /// A fixed-point value `v` scaled by 10^decimals, printed with exactly `decimals` decimals:
