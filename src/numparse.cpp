@@ -1,6 +1,8 @@
 // Decimal parsing and exact fixed-point scaling. See numparse.h.
 #include "lowlevel/numparse.h"
 
+#include "lowlevel/pgm.h"
+
 namespace ll {
 namespace num {
 
@@ -22,36 +24,38 @@ const char* parse(const char* p, Decimal& out) {
     uint32_t ipart = 0;
     uint16_t frac = 0;
     uint8_t sub = 0;
-    // Digits after the point seen so far, counted up to 6; 0xFF before the point.
-    uint8_t decimals = 0xFF;
+    // Place of the next digit: 0xFF before the point, then 0 (tenths) to 6 (beyond the 6th).
+    uint8_t place = 0xFF;
     bool any_digit = false;
     for (;; ++p) {
         uint8_t d = static_cast<uint8_t>(*p - '0');
         if (d > 9) {
-            if (*p != '.' || decimals != 0xFF) break;
-            decimals = 0;
+            if (*p != '.' || place != 0xFF) break;
+            place = 0;
             continue;
         }
         any_digit = true;
-        if (decimals == 0xFF) {
+        if (place == 0xFF) {
             if (ipart > kMaxIpart / 10) return nullptr; // a 10th significant digit
             ipart = (ipart << 3) + (ipart << 1) + d;    // x10 without a call
-        } else if (decimals < 3) {
-            frac = static_cast<uint16_t>(frac * 10u + d);
-        } else if (decimals < 5) {
-            sub = static_cast<uint8_t>(sub * 10u + d);
-        } else {
-            if (decimals == 5 && d >= 5) flags |= Decimal::kRound6;
-            if (d != 0) flags |= Decimal::kInexact;
+            continue;
         }
-        if (decimals < 6) ++decimals;
+        // Decimals 1-3 make `frac` (0..999), 4-5 `sub` (0..99), each weighted by its place.
+        static const uint8_t kWeight[5] LL_PROGMEM = {100, 10, 1, 10, 1};
+        if (place < 3) {
+            frac = static_cast<uint16_t>(
+                frac + static_cast<uint16_t>(d * flash_read_byte(&kWeight[place])));
+        } else if (place < 5) {
+            sub = static_cast<uint8_t>(sub +
+                                       static_cast<uint8_t>(d * flash_read_byte(&kWeight[place])));
+        } else {
+            if (place == 5 && d >= 5) flags |= Decimal::kRound6;
+            if (d != 0) flags |= Decimal::kInexact;
+            if (place == 6) continue;
+        }
+        ++place;
     }
     if (!any_digit) return nullptr;
-    // Missing decimals are zeros: "1.5" is 1 and 500 thousandths, "0.0001" has sub = 10.
-    if (decimals != 0xFF) {
-        for (; decimals < 3; ++decimals) frac = static_cast<uint16_t>(frac * 10u);
-        if (decimals == 4) sub = static_cast<uint8_t>(sub * 10u);
-    }
     // "-0" is not negative.
     if (ipart == 0 && frac == 0 && sub == 0 && !(flags & Decimal::kInexact)) flags = 0;
     out.ipart = ipart;

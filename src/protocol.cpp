@@ -143,11 +143,8 @@ void report_status() {
     out::str(LL_PSTR(",0"));
     // WCO: in the first report after a reset, right after an offset changed, then every 10th
     // report (every 30th while moving), as GRBL 1.1h.
-    if (gcode::g_state.wco_changed) {
+    if (gcode::g_state.wco_changed || p.wco_countdown == 0) {
         gcode::g_state.wco_changed = 0;
-        p.wco_countdown = 0;
-    }
-    if (p.wco_countdown == 0) {
         out::str(LL_PSTR("|WCO:"));
         out::coords(wco);
         p.wco_countdown = ms == motion::State::Idle ? 9 : 29;
@@ -296,13 +293,14 @@ void read_line() {
             p.last_cr = c == '\r';
         } else {
             p.last_cr = 0;
-            if ((c < 0x20 && c != '\t') || c >= 0x7F) {
+            if (c == '\t') c = ' ';
+            if (c < 0x20 || c >= 0x7F) {
                 f |= kBadByte; // GRBL drops such bytes and runs the rest; we refuse the line
             } else if (f & kInSemicolon) {
             } else if (f & kInParen) {
                 if (c == ')') f &= static_cast<uint8_t>(~kInParen);
-            } else if (c == ' ' || c == '\t' || c == '/') {
-                // spaces, and block delete (ignored, as GRBL does)
+            } else if (c == ' ' || c == '/') {
+                // spaces and tabs, and block delete (ignored, as GRBL does)
             } else if (c == '(') {
                 f |= kInParen;
             } else if (c == ';') {
