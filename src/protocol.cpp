@@ -102,7 +102,7 @@ void soft_reset() {
     start(lost);
 }
 
-void report_status() {
+__attribute__((noinline)) void report_status() {
     motion::State ms = motion::state();
     // The state names, indexed below: alarm, check mode, M0 or held, then 5 - motion::State.
     static_assert(uint8_t(motion::State::Idle) == 0 && uint8_t(motion::State::Cycle) == 1 &&
@@ -173,7 +173,7 @@ uint8_t store_setting() {
     return r;
 }
 
-uint8_t system_command() {
+__attribute__((noinline)) uint8_t system_command() {
     const char* s = p.line + 1;
     char c = s[0];
     if (c == 0) {
