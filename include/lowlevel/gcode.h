@@ -35,6 +35,8 @@ struct Modal {
     uint8_t coolant;     ///< 8 or 9 (M8/M9): tracked and reported, no output yet
 };
 
+/// execute() copies modal + tool (8 bytes) and feed, spindle_speed, line_number as 32-bit words:
+/// keep them in this order (static_asserts in gcode.cpp).
 struct State {
     Modal modal;
     uint8_t tool;                  ///< T
