@@ -1,9 +1,11 @@
 // G-code parser and executor. See gcode.h; the stages follow GRBL's gc_execute_line.
 #include "lowlevel/gcode.h"
 
+#include <stddef.h>
+#include <string.h>
+
 #include "lowlevel/fixmath.h"
 #include "lowlevel/line.h"
-
 #include "lowlevel/motion.h"
 #include "lowlevel/numparse.h"
 #include "lowlevel/pgm.h"
@@ -20,23 +22,34 @@ namespace {
 
 using namespace status;
 
-// Modal groups (NIST RS274NGC table 4, GRBL's numbering in the comments), as bits.
+// Modal groups (NIST RS274NGC table 4; GRBL's numbering in the comments). A block keeps the
+// value each command gives its group in Block::g[group]: 0 is the non-modal command, 1 to 7 are
+// the bytes of Modal in order, 8 the program flow. The groups from kGroupArcDistance on have one
+// command each that changes nothing: they only count for error:21.
 enum Group : uint8_t {
-    kGroupNonModal,    // G4 G10 G28 G30 G53 G92 G92.1 (G0)
-    kGroupMotion,      // G0 G1 G2 G3 G2.1 G3.1 G5 G80 (G1)
+    kGroupNonModal,    // G4 G10 G53 G92 G92.1 (G0)
+    kGroupMotion,      // G0 G1 G80, later G2 G3 G2.1 G3.1 G5 (G1)
     kGroupPlane,       // G17 G18 G19 (G2)
-    kGroupDistance,    // G90 G91 (G3)
-    kGroupArcDistance, // G91.1 (G4)
-    kGroupFeedMode,    // G94 (G5)
     kGroupUnits,       // G20 G21 (G6)
-    kGroupCutter,      // G40 (G7)
-    kGroupToolLength,  // G49 (G8)
+    kGroupDistance,    // G90 G91 (G3)
     kGroupCoord,       // G54..G59 (G12)
-    kGroupPath,        // G61 (G13)
-    kGroupFlow,        // M0 M1 M2 M30 (M4)
     kGroupSpindle,     // M3 M4 M5 (M7)
     kGroupCoolant,     // M8 M9 (M8)
+    kGroupFlow,        // M0 M1 M2 M30 (M4)
+    kGroupArcDistance, // G91.1 (G4)
+    kGroupFeedMode,    // G94 (G5)
+    kGroupCutter,      // G40 (G7)
+    kGroupToolLength,  // G49 (G8)
+    kGroupPath,        // G61 (G13)
 };
+static_assert(offsetof(Modal, motion) == kGroupMotion - 1 &&
+                  offsetof(Modal, plane) == kGroupPlane - 1 &&
+                  offsetof(Modal, inches) == kGroupUnits - 1 &&
+                  offsetof(Modal, incremental) == kGroupDistance - 1 &&
+                  offsetof(Modal, coord) == kGroupCoord - 1 &&
+                  offsetof(Modal, spindle) == kGroupSpindle - 1 &&
+                  offsetof(Modal, coolant) == kGroupCoolant - 1 && sizeof(Modal) == 7,
+              "Modal holds the groups 1..7 as bytes, in group order");
 
 enum NonModal : uint8_t {
     kNoNonModal,
@@ -52,39 +65,113 @@ enum AxisCommand : uint8_t { kAxisNone, kAxisNonModal, kAxisMotion };
 
 enum Flow : uint8_t { kFlowRunning, kFlowPause, kFlowEnd };
 
-// Value letters other than the axes, numbered so that their bit in Block::words is their number.
-// F I J K P Q R keep their Decimal until the units of the block are known (the curves to come
-// use I J K R and P Q: G2/G3 I J K R P, G2.1/G3.1 and G5 I J P Q).
+// G and M commands: one 3-byte row each, searched in order.
+//   key:   the G number, or 0x80 + the M number
+//   group: the modal group, and the decimal of the command (G92.1 -> 1) in the high nibble
+//   value: what the command sets its group to, and flags
+enum : uint8_t {
+    kUsesAxes = 0x40, // uses the axis words: two of these in a block is error:24
+    kStrict = 0x80,   // another decimal of this number is unsupported (20), not fractional (23)
+};
+constexpr uint8_t kM = 0x80;
+struct Command {
+    uint8_t key, group, value;
+};
+constexpr uint8_t dec1 = 1 << 4; // group byte of a command with decimal 1
+
+// In the order of their frequency in CAM output: the search stops at the first match.
+const Command kCommands[] LL_PROGMEM = {
+    {1, kGroupMotion, uint8_t(Motion::Linear) | kUsesAxes},
+    {0, kGroupMotion, uint8_t(Motion::Seek) | kUsesAxes},
+    {90, kGroupDistance, 0 | kStrict}, // G90.1: 20
+    {91, kGroupDistance, 1 | kStrict},
+    {21, kGroupUnits, 0},
+    {20, kGroupUnits, 1},
+    {17, kGroupPlane, 0},
+    {94, kGroupFeedMode, 0},
+    {54, kGroupCoord, 0},
+    {kM | 3, kGroupSpindle, 3},
+    {kM | 5, kGroupSpindle, 5},
+    {kM | 8, kGroupCoolant, 8},
+    {kM | 9, kGroupCoolant, 9},
+    {kM | 30, kGroupFlow, kFlowEnd},
+    {kM | 2, kGroupFlow, kFlowEnd},
+    {4, kGroupNonModal, kDwellCmd},
+    {92, kGroupNonModal, kSetOffset | kUsesAxes | kStrict},
+    {53, kGroupNonModal, kAbsoluteOverride},
+    {80, kGroupMotion, uint8_t(Motion::None)},
+    {18, kGroupPlane, 1},
+    {19, kGroupPlane, 2},
+    {40, kGroupCutter, 0},     // cutter compensation off: always off
+    {49, kGroupToolLength, 0}, // tool length offset off: always off
+    {61, kGroupPath, kStrict}, // G61.1: 20
+    {kM | 0, kGroupFlow, kFlowPause},
+    {kM | 1, kGroupFlow, kFlowRunning}, // M1 (optional stop): accepted and ignored, as GRBL
+    {kM | 4, kGroupSpindle, 4},
+    {10, kGroupNonModal, kSetCoordData | kUsesAxes},
+    {92, kGroupNonModal | dec1, kResetOffset | kStrict},
+    {91, kGroupArcDistance | dec1, kStrict}, // G91.1: arc centres incremental, the default
+    {55, kGroupCoord, 1},
+    {56, kGroupCoord, 2},
+    {57, kGroupCoord, 3},
+    {58, kGroupCoord, 4},
+    {59, kGroupCoord, 5},
+    // G2 G3 G5 (and G2.1 G3.1 with the decimal) take their place here as motion commands that
+    // use the axis words, once their generators exist; until then they are error:20.
+};
+constexpr uint8_t kCommandCount = sizeof(kCommands) / sizeof(kCommands[0]);
+
+// Value words, numbered so that their bit in Block::words is their number: the axes first, then
+// F and P (kept as decimals until the units of the block are known), the other words.
+// I J K Q R are only recognised (the curves to come use them: G2/G3 I J K R P, G2.1/G3.1 and G5
+// I J P Q); a block that has one is refused as unused (36).
 enum Word : uint8_t {
-    kWordF,
-    kWordI,
-    kWordJ,
-    kWordK,
+    kWordF = kAxes,
     kWordP,
-    kWordQ,
-    kWordR,
     kWordN,
     kWordL,
     kWordS,
-    kWordT
+    kWordT,
+    kWordI,
+    kWordJ,
+    kWordK,
+    kWordQ,
+    kWordR,
+    kWordCount
 };
-constexpr uint8_t kDecimalWords = kWordR + 1; // Block::v[0..6]; the axes follow
-constexpr uint8_t kWordAxis = 16;             // kLetterInfo of axis a: kWordAxis + a
-constexpr uint8_t kLetterNone = 0xFF;
-constexpr uint16_t bit(Word w) {
-    return static_cast<uint16_t>(1u << w);
+constexpr uint8_t kDecimalSlots = kWordP + 1;
+constexpr uint8_t kLetterG = 0xFD, kLetterM = 0xFE, kLetterNone = 0xFF;
+
+template <bool Small>
+struct MaskOf {
+    using type = uint16_t;
+};
+template <>
+struct MaskOf<false> {
+    using type = uint32_t;
+};
+using WordMask = MaskOf<kWordCount <= 16>::type;
+
+constexpr WordMask bit(uint8_t w) {
+    return static_cast<WordMask>(WordMask(1) << w);
 }
+constexpr WordMask kAxisWords = static_cast<WordMask>(bit(kAxes) - 1);
+constexpr WordMask kNotNegative =
+    bit(kWordF) | bit(kWordP) | bit(kWordN) | bit(kWordS) | bit(kWordT);
+// Words that a command must consume (P, L) or that nothing consumes yet (I J K Q R).
+constexpr WordMask kMustBeUsed =
+    bit(kWordP) | bit(kWordL) | bit(kWordI) | bit(kWordJ) | bit(kWordK) | bit(kWordQ) | bit(kWordR);
 
 constexpr uint8_t axis_letter(uint8_t a) {
-    return a < kAxes ? static_cast<uint8_t>(kWordAxis + a) : kLetterNone;
+    return a < kAxes ? a : kLetterNone;
 }
-// What each letter A..Z is, besides G and M.
+// What each letter A..Z is.
 const uint8_t kLetterInfo[26] LL_PROGMEM = {
     axis_letter(3), axis_letter(4), axis_letter(5), // A B C
     kLetterNone,    kLetterNone,    kWordF,         // D E F
-    kLetterNone,    kLetterNone,    kWordI,         // G H I
+    kLetterG,       kLetterNone,    kWordI,         // G H I
     kWordJ,         kWordK,         kWordL,         // J K L
-    kLetterNone,    kWordN,         kLetterNone,    // M N O
+    kLetterM,       kWordN,         kLetterNone,    // M N O
     kWordP,         kWordQ,         kWordR,         // P Q R
     kWordS,         kWordT,         kLetterNone,    // S T U
     kLetterNone,    kLetterNone,    axis_letter(0), // V W X
@@ -93,266 +180,156 @@ const uint8_t kLetterInfo[26] LL_PROGMEM = {
 
 constexpr uint32_t kNoLineNumber = 0xFFFFFFFFu;
 
+// An axis, F or P word: the number as read, then (axes) its value in um once the units are known.
+union Slot {
+    num::Decimal d;
+    int32_t um;
+};
+
 struct Block {
-    Modal modal;
-    uint8_t non_modal;
+    uint8_t g[kGroupFlow + 1]; // the value of each group with a value (see Group)
     uint8_t axis_command;
-    uint8_t flow;
-    uint8_t axis_words; // bit a: axis a has a word
-    uint8_t l;          // L, 0xFF when not an integer 0..254
+    uint8_t overflow; // an offset or target does not fit an int32 (see add())
+    uint8_t l;        // L, 0xFF when not an integer 0..254
     uint8_t tool;
     uint16_t groups; // modal groups commanded in this block
-    uint16_t words;  // value letters present, bit(Word)
-    uint32_t n;
+    WordMask words;  // value words present, bit(Word)
+    // As State::feed, spindle_speed and line_number (copied as one).
+    uint32_t feed;
     uint32_t s;
-    num::Decimal v[kDecimalWords + kAxes]; // F I J K P Q R, then the axes
+    uint32_t n;
+    Slot v[kDecimalSlots]; // the axes, F, P
 };
+static_assert(offsetof(Block, n) - offsetof(Block, feed) ==
+                  offsetof(State, line_number) - offsetof(State, feed),
+              "feed, S and N are laid out as in State");
 
 // The block being checked and what it computes, kept static: a stack frame this large costs
 // the AVR an address computation on every access (displacements stop at 63 bytes), and the
 // static size is visible to the RAM budget.
 struct Work {
     Block b;
-    int32_t values[kAxes];  // axis words of the block, um
-    int32_t offsets[kAxes]; // new G54 (G10) or G92 offsets, um
-    motion::LineRequest req;
+    union {
+        num::Decimal other; // stage 2: a G, M, N, L, S, T, I, J, K, Q or R number
+        // Stage 3 and 4: the move; for G10 / G92, target_um holds the new offsets (such a
+        // block never moves).
+        motion::LineRequest req;
+    };
 };
 Work w;
 
-// Steps per um of each axis as whole + k / 2^32 (see um_to_steps).
-struct Scale {
-    uint32_t k;     // floor(frac * 2^32 / 10^6), frac = steps_per_unit mod 10^6
-    uint16_t whole; // steps_per_unit / 10^6
-};
-Scale g_scale[kAxes];
-
 // The first decimal of a command number (G92.1 -> 1), or 0xFF with a finer fraction (G1.05).
 uint8_t tenths(const num::Decimal& d) {
-    if (d.frac == 0 && d.sub == 0) return 0; // the usual case: G1, G90
-    if (d.sub != 0 || (d.flags & num::Decimal::kInexact) != 0) return 0xFF;
-    for (uint8_t t = 0; t < 10; ++t) {
-        if (d.frac == t * 100u) return t;
+    if (d.sub != 0 || (d.frac != 0 && (d.flags & num::Decimal::kInexact) != 0)) return 0xFF;
+    uint8_t t = 0;
+    for (uint16_t f = d.frac; f != 0; f = static_cast<uint16_t>(f - 100u)) {
+        if (f < 100) return 0xFF;
+        ++t;
     }
-    return 0xFF;
+    return t;
 }
 
-// Stage 2 helpers: one word each. G and M commands are recognised here (unsupported: 20,
-// two from one modal group: 21, two that use axis words: 24).
-uint8_t import_g(Block& b, const num::Decimal& d) {
-    if (d.negative() || d.ipart > 255) return kUnsupportedCommand;
-    uint8_t code = static_cast<uint8_t>(d.ipart);
-    uint8_t mant = tenths(d);
-    bool mant_used = false;
-    Group group;
-    switch (code) {
-        case 0:
-        case 1:
-        case 80:
-            if (code != 80) {
-                if (b.axis_command != kAxisNone) return kAxisCommandConflict;
-                b.axis_command = kAxisMotion;
-            }
-            group = kGroupMotion;
-            b.modal.motion = code == 0 ? Motion::Seek : code == 1 ? Motion::Linear : Motion::None;
+// Stage 2 for a G or M word (unsupported: 20, two from one modal group: 21, two that use axis
+// words: 24, a decimal where none is defined: 23).
+uint8_t import_command(Block& b, uint8_t m, const num::Decimal& d) {
+    if (m != 0 && !d.integral()) return kCommandValueNotInteger;
+    if (d.negative() || d.ipart > 127) return kUnsupportedCommand;
+    uint8_t key = static_cast<uint8_t>(d.ipart | m);
+    uint8_t dec = tenths(d);
+    if (dec != 0xFF) dec = static_cast<uint8_t>(dec << 4); // as in Command::group
+    const Command* c = nullptr;
+    bool found = false;
+    const Command* e = kCommands;
+    for (uint8_t n = kCommandCount; n != 0; --n, ++e) {
+        if (flash_read_byte(&e->key) != key) continue;
+        c = e;
+        if ((flash_read_byte(&e->group) & 0xF0) == dec) {
+            found = true;
             break;
-        case 2:
-        case 3:
-        case 5:
-            // G2/G3 (arcs), G2.1/G3.1 (ellipses) and G5 (cubic Bezier) take their place here as
-            // motion-group commands that use axis words, once their generators exist.
-            return kUnsupportedCommand;
-        case 4:
-        case 10:
-        case 53:
-        case 92:
-            if (code == 10 || (code == 92 && mant == 0)) {
-                if (b.axis_command != kAxisNone) return kAxisCommandConflict;
-                b.axis_command = kAxisNonModal;
-            }
-            group = kGroupNonModal;
-            if (code == 4) b.non_modal = kDwellCmd;
-            if (code == 10) b.non_modal = kSetCoordData;
-            if (code == 53) b.non_modal = kAbsoluteOverride;
-            if (code == 92) {
-                if (mant > 1) return kUnsupportedCommand; // G92.2, G92.3
-                b.non_modal = mant == 0 ? kSetOffset : kResetOffset;
-                mant_used = true;
-            }
-            break;
-        case 17:
-        case 18:
-        case 19:
-            group = kGroupPlane;
-            b.modal.plane = static_cast<uint8_t>(code - 17);
-            break;
-        case 20:
-        case 21:
-            group = kGroupUnits;
-            b.modal.inches = code == 20 ? 1 : 0;
-            break;
-        case 40:
-            group = kGroupCutter;
-            break; // cutter compensation off: always off
-        case 49:
-            group = kGroupToolLength;
-            break; // tool length offset off: always off
-        case 54:
-        case 55:
-        case 56:
-        case 57:
-        case 58:
-        case 59:
-            group = kGroupCoord;
-            b.modal.coord = static_cast<uint8_t>(code - 54);
-            break;
-        case 61:
-            if (mant != 0) return kUnsupportedCommand; // G61.1
-            group = kGroupPath;
-            break;
-        case 90:
-        case 91:
-            if (mant == 0) {
-                group = kGroupDistance;
-                b.modal.incremental = code == 91 ? 1 : 0;
-            } else {
-                if (code == 90 || mant != 1) return kUnsupportedCommand; // G90.1
-                group = kGroupArcDistance; // G91.1: arc centres are incremental, the default
-                mant_used = true;
-            }
-            break;
-        case 94:
-            group = kGroupFeedMode;
-            break;
-        default:
-            return kUnsupportedCommand; // G28 G30 G38.x G43.1 G64 G93 ...
+        }
     }
-    if (mant != 0 && !mant_used) return kCommandValueNotInteger;
-    uint16_t bit = static_cast<uint16_t>(1u << group);
-    if (b.groups & bit) return kModalGroupViolation;
-    b.groups |= bit;
+    if (c == nullptr) return kUnsupportedCommand; // G28 G30 G38.x G43.1 G64 G93 M6 M7 ...
+    uint8_t group = flash_read_byte(&c->group) & 0x0F;
+    uint8_t value = flash_read_byte(&c->value);
+    if (!found && (value & kStrict)) return kUnsupportedCommand; // G61.1 G90.1 G92.2 ...
+    // As GRBL: the axis-word conflict is checked before the decimal and the modal group.
+    if (value & kUsesAxes) {
+        if (b.axis_command != kAxisNone) return kAxisCommandConflict;
+        b.axis_command = group == kGroupMotion ? kAxisMotion : kAxisNonModal;
+    }
+    if (!found) return kCommandValueNotInteger;
+    uint16_t gbit = static_cast<uint16_t>(1u << group);
+    if (b.groups & gbit) return kModalGroupViolation;
+    b.groups |= gbit;
+    if (group <= kGroupFlow) b.g[group] = value & 0x0F;
     return kOk;
 }
 
-uint8_t import_m(Block& b, const num::Decimal& d) {
-    if (!d.integral()) return kCommandValueNotInteger;
-    if (d.negative() || d.ipart > 255) return kUnsupportedCommand;
-    uint8_t code = static_cast<uint8_t>(d.ipart);
-    Group group;
-    switch (code) {
-        case 0:
-        case 1:
-        case 2:
-        case 30:
-            group = kGroupFlow;
-            if (code == 0) b.flow = kFlowPause;
-            if (code == 2 || code == 30) b.flow = kFlowEnd;
-            break; // M1 (optional stop) is accepted and ignored, as GRBL does
-        case 3:
-        case 4:
-        case 5:
-            group = kGroupSpindle;
-            b.modal.spindle = code;
-            break;
-        case 8:
-        case 9:
-            group = kGroupCoolant;
-            b.modal.coolant = code;
-            break;
-        default:
-            return kUnsupportedCommand; // M6, M7 (no mist output), ...
-    }
-    uint16_t bit = static_cast<uint16_t>(1u << group);
-    if (b.groups & bit) return kModalGroupViolation;
-    b.groups |= bit;
-    return kOk;
-}
-
-uint8_t import_value(Block& b, char letter, const num::Decimal& d) {
-    uint8_t info = flash_read_byte(&kLetterInfo[letter - 'A']);
-    if (info == kLetterNone) return kUnsupportedCommand;
-    if (info >= kWordAxis) {
-        uint8_t a = static_cast<uint8_t>(info - kWordAxis);
-        uint8_t abit = static_cast<uint8_t>(1u << a);
-        if (b.axis_words & abit) return kWordRepeated;
-        b.axis_words |= abit;
-        b.v[kDecimalWords + a] = d;
-        return kOk;
-    }
-    Word word = static_cast<Word>(info);
-    if (b.words & bit(word)) return kWordRepeated;
-    constexpr uint16_t kNotNegative =
-        bit(kWordF) | bit(kWordP) | bit(kWordN) | bit(kWordS) | bit(kWordT);
-    if (d.negative() && (bit(word) & kNotNegative)) return kNegativeValue;
-    b.words |= bit(word);
-    uint32_t v;
-    switch (word) {
-        case kWordN:
-            b.n = num::to_uint(d, 10000000u, v) ? v : kNoLineNumber;
-            break;
-        case kWordL:
-            b.l = num::to_uint(d, 254u, v) ? static_cast<uint8_t>(v) : 0xFF;
-            break;
-        case kWordT:
-            if (!d.integral()) return kCommandValueNotInteger;
-            if (d.ipart > 255) return kMaxValueExceeded;
-            b.tool = static_cast<uint8_t>(d.ipart);
-            break;
-        case kWordS:
-            b.s = d.ipart + (d.frac >= 500 ? 1u : 0u);
-            break;
-        default:
-            b.v[word] = d;
-            break;
+// Stage 2 for any other word, already read into its slot or into w.other.
+uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
+    WordMask wbit = bit(word);
+    if (b.words & wbit) return kWordRepeated;
+    if (d.negative() && (wbit & kNotNegative)) return kNegativeValue;
+    b.words |= wbit;
+    if (word == kWordS) {
+        b.s = d.ipart + (d.frac >= 500 ? 1u : 0u);
+    } else if (word >= kWordN && word <= kWordT) {
+        // N 0..10000000 and L 0..254 (else checked in stage 3), T 0..255.
+        uint32_t v;
+        if (!num::to_uint(d, word == kWordN ? 10000000u : word == kWordL ? 254u : 255u, v)) {
+            if (word == kWordT) return d.integral() ? kMaxValueExceeded : kCommandValueNotInteger;
+            v = kNoLineNumber; // for L: 0xFF
+        }
+        if (word == kWordN) {
+            b.n = v;
+        } else if (word == kWordL) {
+            b.l = static_cast<uint8_t>(v);
+        } else {
+            b.tool = static_cast<uint8_t>(v);
+        }
     }
     return kOk;
 }
 
 // A length word in the units of the block, to um (or a feed to mm/min x1000).
-bool length(const Block& b, uint8_t slot, int32_t& out) {
-    return b.modal.inches ? num::inch_to_milli(b.v[slot], out) : num::to_milli(b.v[slot], out);
+bool length(const Block& b, const num::Decimal& d, int32_t& out) {
+    return num::length_to_milli(d, b.g[kGroupUnits] != 0, out);
 }
 
-bool has_axis(uint8_t axis_words, uint8_t a) {
-    return ((axis_words >> a) & 1) != 0;
+// a + b, or a - b with `subtract`; an overflow sets Block::overflow (checked once per line:
+// error:33). Bit 31 of (a ^ r) & (b' ^ r) is the signed overflow of r = a + b'.
+__attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = false) {
+    uint32_t ua = static_cast<uint32_t>(a), ub = static_cast<uint32_t>(b);
+    uint32_t r = subtract ? ua - ub : ua + ub;
+    if (subtract) ub = ~ub; // a - b overflows as a + ~b would (the sign of -b is ~b's)
+    if (((ua ^ r) & (ub ^ r)) >> 31) w.b.overflow = 1;
+    return static_cast<int32_t>(r);
 }
 
-bool add(int32_t a, int32_t b, int32_t& out) {
-    return !__builtin_add_overflow(a, b, &out);
+// Copies `words` 32-bit words: 4 cycles a byte on the AVR, against 7 for memcpy's byte loop.
+__attribute__((noinline)) void copy_words(void* dst, const void* src, uint8_t words) {
+    uint8_t* d = static_cast<uint8_t*>(dst);
+    const uint8_t* s = static_cast<const uint8_t*>(src);
+    do {
+        uint32_t v;
+        memcpy(&v, s, sizeof(v));
+        memcpy(d, &v, sizeof(v));
+        d += sizeof(v);
+        s += sizeof(v);
+    } while (--words != 0);
 }
-bool sub(int32_t a, int32_t b, int32_t& out) {
-    return !__builtin_sub_overflow(a, b, &out);
+
+void set_end_modes(Modal& m) {
+    // Program end resets groups 1 2 3 5 7 12 and M7 M8 M9, as GRBL (after LinuxCNC) does.
+    m.motion = Motion::Linear;
+    m.plane = 0;
+    m.incremental = 0;
+    m.coord = 0;
+    m.spindle = 5;
+    m.coolant = 9;
 }
 
 } // namespace
-
-// round(|um| * s / 10^6) without a division: q = floor(|um| * k / 2^32) is the floor of
-// |um| * frac / 10^6 or one less (k is short of the exact ratio by less than 1 and |um| < 2^31);
-// the remainder |um| * frac - q * 10^6 is then exact in 32-bit wrap-around arithmetic (it is
-// below 2 * 10^6) and settles both the missing unit and the rounding. The whole part of the
-// ratio (1000 steps/mm and more) is one multiplication.
-bool um_to_steps(uint8_t axis, int32_t um, int32_t& steps) {
-    const Scale& sc = g_scale[axis];
-    bool negative = um < 0;
-    uint32_t m = negative ? 0u - static_cast<uint32_t>(um) : static_cast<uint32_t>(um);
-    uint32_t frac = g_settings.axis[axis].steps_per_unit;
-    if (sc.whole != 0) frac -= sc.whole * 1000000u;
-    uint32_t q, lo;
-    num::mul64(m, sc.k, q, lo);
-    uint32_t r = m * frac - q * 1000000u;
-    if (r >= 1000000u) {
-        r -= 1000000u;
-        ++q;
-    }
-    if (r >= 500000u) ++q; // half away from zero, on the magnitude
-    if (sc.whole != 0) {
-        uint32_t hi, whole;
-        num::mul64(m, sc.whole, hi, whole);
-        if (hi != 0 || __builtin_add_overflow(q, whole, &q)) return false;
-    }
-    if (q > 0x7FFFFFFFu) return false;
-    steps = negative ? -static_cast<int32_t>(q) : static_cast<int32_t>(q);
-    return true;
-}
 
 uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     State& st = g_state;
@@ -361,202 +338,188 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
 
     // ---- Stage 1: a block that starts from the current modes.
     Block& b = w.b;
-    b.modal = st.modal;
-    b.non_modal = kNoNonModal;
+    static_assert(offsetof(State, tool) == sizeof(Modal) && sizeof(Modal) + 1 == 8,
+                  "modal and tool are two words");
+    b.g[kGroupNonModal] = kNoNonModal;
+    copy_words(&b.g[kGroupMotion], &st.modal, 2); // and the tool into the flow byte:
+    b.g[kGroupFlow] = kFlowRunning;
     b.axis_command = kAxisNone;
-    b.flow = kFlowRunning;
-    b.axis_words = 0;
+    b.overflow = 0;
     b.l = 0xFF;
     b.tool = st.tool;
     b.groups = 0;
     b.words = 0;
+    copy_words(&b.feed, &st.feed, 2); // and S
     b.n = 0;
-    b.s = st.spindle_speed;
 
     // ---- Stage 2: import every word (letter + number), checking repeats, modal groups and
     // negative F N P S T.
-    uint8_t i = 0;
-    while (line[i] != 0) {
-        char letter = line[i++];
+    while (*line != 0) {
+        char letter = *line++;
         if (letter < 'A' || letter > 'Z') return kExpectedCommandLetter;
-        num::Decimal d;
-        if (!num::parse(line, i, d)) return kBadNumberFormat;
-        uint8_t r = letter == 'G'   ? import_g(b, d)
-                    : letter == 'M' ? import_m(b, d)
-                                    : import_value(b, letter, d);
+        uint8_t word = flash_read_byte(&kLetterInfo[letter - 'A']);
+        num::Decimal& d = word < kDecimalSlots ? b.v[word].d : w.other;
+        line = num::parse(line, d);
+        if (line == nullptr) return kBadNumberFormat;
+        uint8_t r = kUnsupportedCommand;
+        if (word < kWordCount) {
+            r = import_value(b, word, d);
+        } else if (word != kLetterNone) {
+            r = import_command(b, word == kLetterM ? kM : 0, d);
+        }
         if (r != kOk) return r;
     }
 
     // ---- Stage 3: check the block as a whole and compute everything it will change.
+    uint8_t non_modal = b.g[kGroupNonModal];
+    Motion motion = static_cast<Motion>(b.g[kGroupMotion]);
+    uint8_t axes = static_cast<uint8_t>(b.words & kAxisWords);
     // [0] Axis words without a command that uses them: the current motion mode does.
-    if (b.axis_words != 0 && b.axis_command == kAxisNone) b.axis_command = kAxisMotion;
+    if (axes != 0 && b.axis_command == kAxisNone) b.axis_command = kAxisMotion;
     if ((b.words & bit(kWordN)) && b.n == kNoLineNumber) return kInvalidLineNumber;
 
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
-    uint32_t feed = st.feed;
     if (b.words & bit(kWordF)) {
         int32_t f;
-        if (!length(b, kWordF, f)) return kBadNumberFormat;
-        feed = static_cast<uint32_t>(f);
+        if (!length(b, b.v[kWordF].d, f)) return kBadNumberFormat;
+        b.feed = static_cast<uint32_t>(f);
     }
 
     // [10] Dwell: P seconds.
     int32_t dwell_ms = 0;
-    if (b.non_modal == kDwellCmd) {
+    if (non_modal == kDwellCmd) {
         if (!(b.words & bit(kWordP))) return kValueWordMissing;
-        if (!num::to_milli(b.v[kWordP], dwell_ms)) return kBadNumberFormat;
-        b.words &= static_cast<uint16_t>(~bit(kWordP));
+        if (!num::to_milli(b.v[kWordP].d, dwell_ms)) return kBadNumberFormat;
+        b.words = static_cast<WordMask>(b.words & ~bit(kWordP));
     }
 
     // [15] Coordinate system: G54 only.
-    if (b.modal.coord != 0) return kUnsupportedCoordSys;
+    if (b.g[kGroupCoord] != 0) return kUnsupportedCoordSys;
 
-    // [19] Non-modal commands that use axis words, and the motion target.
-    int32_t* values = w.values;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        values[a] = 0;
-        if (has_axis(b.axis_words, a)) {
-            if (!length(b, static_cast<uint8_t>(kDecimalWords + a), values[a])) {
-                return kBadNumberFormat;
-            }
-        }
+    // [19] The axis words in um, then the non-modal commands that use them, or the target.
+    for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
+        if (!(m & 1)) continue;
+        int32_t um;
+        if (!length(b, b.v[a].d, um)) return kBadNumberFormat;
+        b.v[a].um = um;
     }
-    int32_t* offsets = w.offsets;
-    motion::LineRequest& req = w.req;
-    switch (b.non_modal) {
-        case kSetCoordData: { // G10 L2 / L20 P0|P1: G54
-            if (b.axis_words == 0) return kNoAxisWords;
-            if (!(b.words & bit(kWordP)) || !(b.words & bit(kWordL))) {
-                return kValueWordMissing;
-            }
+    // One pass over the axes computes either the new offsets (G10, G92) or the target of a
+    // move: an axis without a word keeps `keep`, an axis with a word gets its value, turned
+    // into a machine position by `op`.
+    enum Op : uint8_t {
+        kAsIs,         // G53 (machine coordinates), G10 L2 (the value is the new G54)
+        kPlusPosition, // G91
+        kPlusOffsets,  // G90: work position + G54 + G92
+        kFromPosition, // G92, G10 L20: position - the other offset - value
+    };
+    bool offsets = non_modal == kSetCoordData || non_modal == kSetOffset;
+    const int32_t* keep = st.position;
+    const int32_t* other = st.g54;
+    uint8_t op = non_modal == kAbsoluteOverride ? kAsIs
+                 : b.g[kGroupDistance]          ? kPlusPosition
+                                                : kPlusOffsets;
+    if (offsets) {
+        // G92: the current position becomes the given work position. G10 L20 P0|P1: the same
+        // for G54; G10 L2: the given values are the new G54.
+        if (axes == 0) return kNoAxisWords;
+        keep = st.g92;
+        op = kFromPosition;
+        if (non_modal == kSetCoordData) {
+            if (!(b.words & bit(kWordP)) || !(b.words & bit(kWordL))) return kValueWordMissing;
             uint32_t p;
-            if (!num::to_uint(b.v[kWordP], 255u, p) || p > 1) return kUnsupportedCoordSys;
+            if (!num::to_uint(b.v[kWordP].d, 1u, p)) return kUnsupportedCoordSys;
             if (b.l != 2 && b.l != 20) return kUnsupportedCommand;
-            if (b.l == 2 && (b.words & bit(kWordR))) return kUnsupportedCommand;
-            b.words &= static_cast<uint16_t>(~(bit(kWordL) | bit(kWordP)));
-            for (uint8_t a = 0; a < kAxes; ++a) {
-                offsets[a] = st.g54[a];
-                if (!(has_axis(b.axis_words, a))) continue;
-                if (b.l == 2) {
-                    offsets[a] = values[a];
-                } else if (!sub(st.position[a], st.g92[a], offsets[a]) ||
-                           !sub(offsets[a], values[a], offsets[a])) {
-                    return kInvalidTarget;
-                }
+            if (b.l == 2) {
+                if (b.words & bit(kWordR)) return kUnsupportedCommand;
+                op = kAsIs;
             }
-            break;
+            b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
+            keep = st.g54;
+            other = st.g92;
         }
-        case kSetOffset: // G92: the current position becomes the given work position
-            if (b.axis_words == 0) return kNoAxisWords;
-            for (uint8_t a = 0; a < kAxes; ++a) {
-                offsets[a] = st.g92[a];
-                if (!(has_axis(b.axis_words, a))) continue;
-                if (!sub(st.position[a], st.g54[a], offsets[a]) ||
-                    !sub(offsets[a], values[a], offsets[a])) {
-                    return kInvalidTarget;
-                }
+    } else if (non_modal == kAbsoluteOverride && motion > Motion::Linear) {
+        return kG53InvalidMotionMode;
+    }
+    motion::LineRequest& req = w.req;
+    if (offsets || b.axis_command == kAxisMotion) {
+        copy_words(req.target_um, keep, kAxes); // for G10 / G92: the new offsets
+        copy_words(req.target_steps, st.position_steps, kAxes);
+        for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
+            if (!(m & 1)) continue;
+            int32_t t = b.v[a].um;
+            if (op == kPlusPosition) {
+                t = add(t, st.position[a]);
+            } else if (op == kPlusOffsets) {
+                t = add(add(t, st.g54[a]), st.g92[a]);
+            } else if (op == kFromPosition) {
+                t = add(add(st.position[a], other[a], true), t, true);
             }
-            break;
-        default:
-            if (b.non_modal == kAbsoluteOverride && b.modal.motion != Motion::Seek &&
-                b.modal.motion != Motion::Linear) {
-                return kG53InvalidMotionMode;
+            req.target_um[a] = t;
+            // Always from the absolute target: no rounding error accumulates. One move travels
+            // at most kMaxLineTicks steps per axis (line.h).
+            int32_t& steps = req.target_steps[a];
+            if (!offsets &&
+                (!num::mul_div_round(t, g_settings.axis[a].steps_per_unit, 1000000u, steps) ||
+                 abs32(static_cast<int32_t>(static_cast<uint32_t>(steps) -
+                                            static_cast<uint32_t>(st.position_steps[a]))) >
+                     kMaxLineTicks)) {
+                b.overflow = 1;
             }
-            if (b.axis_command != kAxisMotion) break;
-            for (uint8_t a = 0; a < kAxes; ++a) {
-                int32_t t = st.position[a];
-                int32_t steps = st.position_steps[a];
-                if (has_axis(b.axis_words, a)) {
-                    t = values[a];
-                    bool ok = true;
-                    if (b.non_modal == kAbsoluteOverride) {
-                        // G53: machine coordinates, whatever the distance mode
-                    } else if (b.modal.incremental) {
-                        ok = add(st.position[a], t, t);
-                    } else {
-                        ok = add(t, st.g54[a], t) && add(t, st.g92[a], t);
-                    }
-                    // Always from the absolute target: no rounding error accumulates.
-                    if (!ok || !um_to_steps(a, t, steps)) return kInvalidTarget;
-                    // One move travels at most kMaxLineTicks steps per axis (line.h).
-                    if (abs32(steps - st.position_steps[a]) > kMaxLineTicks) return kInvalidTarget;
-                }
-                req.target_um[a] = t;
-                req.target_steps[a] = steps;
-            }
-            break;
+        }
+        if (b.overflow) return kInvalidTarget;
     }
 
     // [20] Motion modes.
-    if (b.modal.motion == Motion::None) {
-        if (b.axis_words != 0) return kAxisWordsExist;
+    if (motion == Motion::None) {
+        if (axes != 0) return kAxisWordsExist;
     } else if (b.axis_command == kAxisMotion) {
-        if (b.modal.motion != Motion::Seek && feed == 0) return kUndefinedFeedRate;
-        if (b.axis_words == 0) b.axis_command = kAxisNone; // G0/G1 alone: a mode change only
+        if (motion != Motion::Seek && b.feed == 0) return kUndefinedFeedRate;
+        if (axes == 0) b.axis_command = kAxisNone; // G0/G1 alone: a mode change only
     }
 
     // [0] Every word must have been used.
     // (Axis words always have a user by now: the motion mode takes them, or G80 refused them.)
-    uint16_t unused =
-        b.words & static_cast<uint16_t>(~(bit(kWordN) | bit(kWordF) | bit(kWordS) | bit(kWordT)));
-    if (unused != 0) return kUnusedWords;
+    if (b.words & kMustBeUsed) return kUnusedWords;
 
     // ---- The block is valid. Conditions to wait for, still without any side effect.
     bool check = (flags & kCheckMode) != 0;
     bool moves = b.axis_command == kAxisMotion;
     if (!check) {
-        if (b.non_modal == kDwellCmd && !(flags & kDwellDone)) {
+        if (non_modal == kDwellCmd && !(flags & kDwellDone)) {
             outcome.dwell_ms = static_cast<uint32_t>(dwell_ms);
             return kDwell;
         }
-        if ((b.non_modal == kSetCoordData || b.non_modal == kSetOffset ||
-             b.non_modal == kResetOffset) &&
-            motion::state() != motion::State::Idle) {
+        if ((offsets || non_modal == kResetOffset) && motion::state() != motion::State::Idle) {
             return kRetryWhenIdle;
         }
         if (moves && !motion::can_accept()) return kRetryWhenAccepting;
     }
 
     // ---- Stage 4: execute, in GRBL's order.
-    st.line_number = b.n;
-    st.feed = feed;
-    st.spindle_speed = b.s;
+    copy_words(&st.modal, &b.g[kGroupMotion], 2); // coord: 0, checked above; the tool:
     st.tool = b.tool;
-    st.modal.spindle = b.modal.spindle;
-    st.modal.coolant = b.modal.coolant;
-    st.modal.plane = b.modal.plane;
-    st.modal.inches = b.modal.inches;
-    st.modal.incremental = b.modal.incremental;
-    if (b.non_modal == kSetCoordData) {
-        for (uint8_t a = 0; a < kAxes; ++a) st.g54[a] = offsets[a];
-        if (!check) settings::save_coord(st.g54);
+    copy_words(&st.feed, &b.feed, 3); // and S, N
+    if (offsets) {
+        bool g10 = non_modal == kSetCoordData;
+        copy_words(g10 ? st.g54 : st.g92, req.target_um, kAxes);
+        if (g10 && !check) settings::save_coord(st.g54);
         st.wco_changed = 1;
-    } else if (b.non_modal == kSetOffset || b.non_modal == kResetOffset) {
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            st.g92[a] = b.non_modal == kSetOffset ? offsets[a] : 0;
-        }
+    } else if (non_modal == kResetOffset) {
+        memset(st.g92, 0, sizeof(st.g92));
         st.wco_changed = 1;
     }
-    st.modal.motion = b.modal.motion;
     if (moves) {
-        req.feed = feed;
-        req.rapid = b.modal.motion == Motion::Seek;
+        req.feed = b.feed;
+        req.rapid = motion == Motion::Seek;
         if (!check) motion::push_line(req); // cannot refuse: the length was checked above
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            st.position[a] = req.target_um[a];
-            st.position_steps[a] = req.target_steps[a];
-        }
+        copy_words(st.position, req.target_um, kAxes);
+        copy_words(st.position_steps, req.target_steps, kAxes);
     }
-    if (b.flow == kFlowPause) {
+    uint8_t flow = b.g[kGroupFlow];
+    if (flow == kFlowPause) {
         if (!check) outcome.then = Then::Pause;
-    } else if (b.flow == kFlowEnd) {
-        // Program end resets groups 1 2 3 5 7 12 and M7 M8 M9, as GRBL (after LinuxCNC) does.
-        st.modal.motion = Motion::Linear;
-        st.modal.plane = 0;
-        st.modal.incremental = 0;
-        st.modal.coord = 0;
-        st.modal.spindle = 5;
-        st.modal.coolant = 9;
+    } else if (flow == kFlowEnd) {
+        set_end_modes(st.modal);
         outcome.then = Then::ProgramEnd;
     }
     return kOk;
@@ -564,43 +527,33 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
 
 bool reset() {
     State& st = g_state;
+    memset(&st, 0, sizeof(st));
+    set_end_modes(st.modal);
     st.modal.motion = Motion::Seek;
-    st.modal.plane = 0;
-    st.modal.inches = 0;
-    st.modal.incremental = 0;
-    st.modal.coord = 0;
-    st.modal.spindle = 5;
-    st.modal.coolant = 9;
-    st.feed = 0;
-    st.spindle_speed = 0;
-    st.tool = 0;
-    st.line_number = 0;
-    for (uint8_t a = 0; a < kAxes; ++a) st.g92[a] = 0;
     bool ok = settings::load_coord(st.g54);
-    settings_changed(); // the step scales
     sync_position();
     st.wco_changed = 1;
     return ok;
 }
 
-void sync_position() {
-    int32_t steps[kAxes];
-    motion::position(steps);
+void steps_to_um(const int32_t* steps, int32_t* um) {
     for (uint8_t a = 0; a < kAxes; ++a) {
-        g_state.position_steps[a] = steps[a];
-        num::mul_div_round(steps[a], 1000000u, g_settings.axis[a].steps_per_unit,
-                           g_state.position[a]);
+        num::mul_div_round(steps[a], 1000000u, g_settings.axis[a].steps_per_unit, um[a]);
     }
+}
+
+void sync_position() {
+    motion::position(g_state.position_steps);
+    steps_to_um(g_state.position_steps, g_state.position);
 }
 
 void settings_changed() {
     for (uint8_t a = 0; a < kAxes; ++a) {
-        uint32_t s = g_settings.axis[a].steps_per_unit;
-        uint16_t whole = static_cast<uint16_t>(s / 1000000u);
-        uint32_t rem;
-        g_scale[a].whole = whole;
-        g_scale[a].k = num::div64(s - whole * 1000000u, 0, 1000000u, rem);
-        um_to_steps(a, g_state.position[a], g_state.position_steps[a]);
+        int32_t steps;
+        if (num::mul_div_round(g_state.position[a], g_settings.axis[a].steps_per_unit, 1000000u,
+                               steps)) {
+            g_state.position_steps[a] = steps;
+        }
     }
 }
 
@@ -614,51 +567,39 @@ void work_offset(int32_t (&um)[kAxes]) {
 void report_modes() {
     const Modal& m = g_state.modal;
     static const uint8_t kMotionCode[8] LL_PROGMEM = {0, 1, 2, 3, 2, 3, 5, 80};
-    uint8_t motion = static_cast<uint8_t>(m.motion);
     out::str(LL_PSTR("[GC:G"));
-    out::u32(flash_read_byte(&kMotionCode[motion]));
-    if (m.motion == Motion::EllipseCw || m.motion == Motion::EllipseCcw) out::str(LL_PSTR(".1"));
-    out::str(LL_PSTR(" G"));
-    out::u32(54u + m.coord);
-    out::str(LL_PSTR(" G"));
-    out::u32(17u + m.plane);
-    out::str(m.inches ? LL_PSTR(" G20 G") : LL_PSTR(" G21 G"));
-    out::u32(90u + m.incremental);
-    out::str(LL_PSTR(" G94 M"));
-    out::u32(m.spindle);
-    out::str(LL_PSTR(" M"));
-    out::u32(m.coolant);
-    out::str(LL_PSTR(" T"));
-    out::u32(g_state.tool);
+    out::u8(flash_read_byte(&kMotionCode[static_cast<uint8_t>(m.motion)]));
+    out::word('G', static_cast<uint8_t>(54u + m.coord));
+    out::word('G', static_cast<uint8_t>(17u + m.plane));
+    out::word('G', static_cast<uint8_t>(21u - m.inches));
+    out::word('G', static_cast<uint8_t>(90u + m.incremental));
+    out::str(LL_PSTR(" G94"));
+    out::word('M', m.spindle);
+    out::word('M', m.coolant);
+    out::word('T', g_state.tool);
     out::str(LL_PSTR(" F"));
     out::rate(g_state.feed);
     out::str(LL_PSTR(" S"));
     out::u32(g_state.spindle_speed);
-    out::ch(']');
-    out::eol();
+    out::line(LL_PSTR("]"));
 }
 
 void report_offsets() {
-    static const int32_t kZero[kAxes] = {};
-    for (uint8_t g = 54; g <= 59; ++g) {
+    // G54 is real, G55..G59, G28 and G30 are zeros (not supported), then G92.
+    static const uint8_t kCodes[9] LL_PROGMEM = {54, 55, 56, 57, 58, 59, 28, 30, 92};
+    for (uint8_t i = 0; i < sizeof(kCodes); ++i) {
+        uint8_t code = flash_read_byte(&kCodes[i]);
         out::str(LL_PSTR("[G"));
-        out::u32(g);
+        out::u8(code);
         out::ch(':');
-        out::coords(g == 54 ? g_state.g54 : kZero);
-        out::ch(']');
-        out::eol();
+        out::coords(code == 54 ? g_state.g54 : code == 92 ? g_state.g92 : nullptr);
+        out::line(LL_PSTR("]"));
     }
-    out::str(LL_PSTR("[G28:"));
-    out::coords(kZero);
-    out::str(LL_PSTR("]\r\n[G30:"));
-    out::coords(kZero);
-    out::str(LL_PSTR("]\r\n[G92:"));
-    out::coords(g_state.g92);
-    out::str(LL_PSTR("]\r\n[TLO:"));
-    out::fixed(0, g_settings.report_inches ? 4 : 3);
+    out::str(LL_PSTR("[TLO:"));
+    out::coord(0);
     out::str(LL_PSTR("]\r\n[PRB:"));
-    out::coords(kZero);
-    out::str(LL_PSTR(":0]\r\n"));
+    out::coords(nullptr);
+    out::line(LL_PSTR(":0]"));
 }
 
 } // namespace gcode

@@ -15,18 +15,26 @@ const uint32_t kPow10[10] LL_PROGMEM = {1u,      10u,      100u,      1000u,    
 // Digits of m, with at least `decimals + 1` of them and a point before the last `decimals`.
 void digits(uint32_t m, uint8_t decimals) {
     bool started = false;
-    for (int8_t p = 9; p >= 0; --p) {
+    uint8_t p = 10;
+    do {
+        --p;
         uint32_t pw = flash_read_u32(&kPow10[p]);
         char d = '0';
         while (m >= pw) {
             m -= pw;
             ++d;
         }
-        if (d != '0' || p <= static_cast<int8_t>(decimals)) started = true;
+        if (d != '0' || p <= decimals) started = true;
         if (!started) continue;
-        if (decimals != 0 && p == static_cast<int8_t>(decimals) - 1) ch('.');
+        if (p + 1 == decimals) ch('.');
         ch(d);
-    }
+    } while (p != 0);
+}
+
+// value x mul / div, rounded half away from zero, printed with `decimals` decimals.
+void scaled(int32_t v, uint8_t mul, uint16_t div, uint8_t decimals) {
+    if (div != 1) num::mul_div_round(v, mul, div, v);
+    fixed(v, decimals);
 }
 } // namespace
 
@@ -48,7 +56,22 @@ void eol() {
     ch('\n');
 }
 
+void line(const FlashChar* s) {
+    str(s);
+    eol();
+}
+
 void u32(uint32_t v) {
+    digits(v, 0);
+}
+
+void u8(uint8_t v) {
+    digits(v, 0);
+}
+
+void word(char letter, uint8_t v) {
+    ch(' ');
+    ch(letter);
     digits(v, 0);
 }
 
@@ -61,28 +84,28 @@ void fixed(int32_t v, uint8_t decimals) {
     digits(m, decimals);
 }
 
+void coord(int32_t um) {
+    // 1e-4 in = 2.54 um
+    if (g_settings.report_inches) {
+        scaled(um, 50, 127, 4);
+    } else {
+        fixed(um, 3);
+    }
+}
+
 void coords(const int32_t* um) {
     for (uint8_t a = 0; a < kAxes; ++a) {
         if (a != 0) ch(',');
-        if (g_settings.report_inches) {
-            int32_t in; // 1e-4 in = 2.54 um
-            num::mul_div_round(um[a], 50u, 127u, in);
-            fixed(in, 4);
-        } else {
-            fixed(um[a], 3);
-        }
+        coord(um != nullptr ? um[a] : 0);
     }
 }
 
 void rate(uint32_t milli_per_min) {
-    int32_t v;
     int32_t m = static_cast<int32_t>(milli_per_min & 0x7FFFFFFFu);
     if (g_settings.report_inches) {
-        num::mul_div_round(m, 1u, 2540u, v); // in/min x10
-        fixed(v, 1);
+        scaled(m, 1, 2540, 1); // in/min x10
     } else {
-        num::mul_div_round(m, 1u, 1000u, v);
-        fixed(v, 0);
+        scaled(m, 1, 1000, 0);
     }
 }
 
@@ -91,7 +114,7 @@ void status(uint8_t code) {
         str(LL_PSTR("ok"));
     } else {
         str(LL_PSTR("error:"));
-        u32(code);
+        u8(code);
     }
     eol();
 }
@@ -99,8 +122,7 @@ void status(uint8_t code) {
 void msg(const FlashChar* text) {
     str(LL_PSTR("[MSG:"));
     str(text);
-    ch(']');
-    eol();
+    line(LL_PSTR("]"));
 }
 
 } // namespace out

@@ -2,6 +2,9 @@
 // non-blocking waits (planner full, G4, M0, M2/M30). Implements app.h. See docs/protocol.md.
 #include "lowlevel/protocol.h"
 
+#include <stddef.h>
+#include <string.h>
+
 #include "lowlevel/app.h"
 #include "lowlevel/gcode.h"
 #include "lowlevel/hal.h"
@@ -31,17 +34,21 @@ enum : uint8_t {
 };
 
 // What the protocol waits for before it reads the next line. Every wait keeps serving
-// real-time commands and motion::poll(); the line's `ok` comes when the wait ends.
+// real-time commands and motion::poll(); the line's `ok` comes when the wait ends. The first
+// three follow gcode::execute()'s retry codes, in their order.
 enum class Wait : uint8_t {
     None,          // assembling a line
     WhenAccepting, // the planner is full: execute again when it has room
     WhenIdle,      // G10/G92: execute again when motion is idle
     DwellWhenIdle, // G4: start the dwell when motion is idle
-    Dwell,         // G4: until `deadline`
+    Dwell,         // G4: until `dwell` (then a hal::millis() time)
     PauseWhenIdle, // M0: hold when motion is idle
     Paused,        // M0: until cycle start ('~')
     EndWhenIdle,   // M2/M30: [MSG:Pgm End] when motion is idle
 };
+static_assert(gcode::kRetryWhenIdle == gcode::kRetryWhenAccepting + 1 &&
+                  gcode::kDwell == gcode::kRetryWhenAccepting + 2,
+              "retry codes map to waits");
 
 // Special result of a `$` command: answer ok, then soft-reset ($C off, $RST).
 constexpr uint8_t kOkThenReset = 0xFF;
@@ -50,30 +57,21 @@ struct Protocol {
     char line[protocol::kLineMax + 1];
     uint8_t len;
     uint8_t flags;
-    uint8_t last_cr;     // the previous byte was '\r': a '\n' right after it ends nothing
-    uint8_t lost_after;  // after this many more bytes, the line in progress lost bytes
-    uint8_t rx_capacity; // receive buffer size, for `$I`
-    uint8_t gflags;      // gcode::execute() flags for the pending line
+    uint8_t last_cr;    // the previous byte was '\r': a '\n' right after it ends nothing
+    uint8_t lost_after; // after this many more bytes, the line in progress lost bytes
+    uint8_t gflags;     // gcode::execute() flags for the pending line
     Wait wait;
-    uint8_t alarm;
     uint8_t check;
     uint8_t wco_countdown; // status reports until WCO: is shown again
-    uint32_t dwell_ms;
-    uint32_t deadline; // hal::millis() at the end of the dwell
+    uint32_t dwell;        // G4: ms, then (Wait::Dwell) hal::millis() at its end
+    // Kept by a soft reset:
+    uint8_t alarm;
+    uint8_t rx_capacity; // receive buffer size, for `$I`
 };
 Protocol p;
 
 bool motion_idle() {
     return motion::state() == motion::State::Idle;
-}
-
-void banner() {
-    out::str(LL_PSTR("\r\nGrbl 1.1h ['$' for help]\r\n"));
-}
-
-void new_line() {
-    p.len = 0;
-    p.flags = 0;
 }
 
 void finish(uint8_t code) {
@@ -82,81 +80,78 @@ void finish(uint8_t code) {
     p.gflags = 0;
 }
 
-void soft_reset() {
-    bool lost = motion::abort();
-    hal::serial_rx_clear();
-    hal::serial_rx_overflowed(); // clears the flag: nothing is pending any more
-    new_line();
-    p.last_cr = 0;
-    p.lost_after = 0;
-    p.wait = Wait::None;
-    p.gflags = 0;
-    p.check = 0;
-    p.wco_countdown = 0;
+// After power-up or a soft reset (p cleared): the parser, the GRBL messages, the banner.
+void start(bool lost) {
     bool coord_ok = gcode::reset();
     // GRBL 1.1h order: the alarm of the abort, then (re-initialisation) the banner, then the
     // reminder that the alarm locks G-code.
     if (lost) {
         p.alarm = 1;
-        out::str(LL_PSTR("ALARM:3\r\n"));
+        out::line(LL_PSTR("ALARM:3"));
     }
     if (!coord_ok) out::status(kSettingReadFail);
-    banner();
+    out::line(LL_PSTR("\r\nGrbl 1.1h ['$' for help]"));
     if (p.alarm) out::msg(LL_PSTR("'$H'|'$X' to unlock"));
 }
 
-void report_status() {
-    out::ch('<');
+void soft_reset() {
+    bool lost = motion::abort();
+    hal::serial_rx_clear();
+    hal::serial_rx_overflowed(); // clears the flag: nothing is pending any more
+    memset(&p, 0, offsetof(Protocol, alarm));
+    start(lost);
+}
+
+__attribute__((noinline)) void report_status() {
     motion::State ms = motion::state();
-    if (p.alarm) {
-        out::str(LL_PSTR("Alarm"));
-    } else if (p.check) {
-        out::str(LL_PSTR("Check"));
-    } else if (p.wait == Wait::Paused || ms == motion::State::Held) {
-        out::str(LL_PSTR("Hold:0"));
-    } else if (ms == motion::State::Holding) {
-        out::str(LL_PSTR("Hold:1"));
-    } else if (ms == motion::State::Cycle) {
-        out::str(LL_PSTR("Run"));
-    } else {
-        out::str(LL_PSTR("Idle"));
+    // The state names, indexed below: alarm, check mode, M0 or held, then 5 - motion::State.
+    static_assert(uint8_t(motion::State::Idle) == 0 && uint8_t(motion::State::Cycle) == 1 &&
+                      uint8_t(motion::State::Holding) == 2 && uint8_t(motion::State::Held) == 3,
+                  "state names follow motion::State");
+    uint8_t name = p.alarm                  ? 0
+                   : p.check                ? 1
+                   : p.wait == Wait::Paused ? 2
+                                            : static_cast<uint8_t>(5 - uint8_t(ms));
+    const char* s =
+        reinterpret_cast<const char*>(LL_PSTR("<Alarm\0<Check\0<Hold:0\0<Hold:1\0<Run\0<Idle"));
+    while (name != 0) {
+        if (flash_read_byte(s++) == 0) --name;
     }
-    int32_t steps[kAxes], pos[kAxes], wco[kAxes];
-    motion::position(steps);
+    out::str(reinterpret_cast<const FlashChar*>(s));
+    int32_t pos[kAxes], wco[kAxes];
+    motion::position(pos);
+    gcode::steps_to_um(pos, pos);
     gcode::work_offset(wco);
     bool mpos = (g_settings.status_mask & 1u) != 0;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        num::mul_div_round(steps[a], 1000000u, g_settings.axis[a].steps_per_unit, pos[a]);
+    if (!mpos) {
         // Wrapping subtraction: a display value, never UB even for absurd offsets.
-        if (!mpos)
+        for (uint8_t a = 0; a < kAxes; ++a) {
             pos[a] =
                 static_cast<int32_t>(static_cast<uint32_t>(pos[a]) - static_cast<uint32_t>(wco[a]));
+        }
     }
     out::str(mpos ? LL_PSTR("|MPos:") : LL_PSTR("|WPos:"));
     out::coords(pos);
     if (g_settings.status_mask & 2u) {
         out::str(LL_PSTR("|Bf:"));
-        out::u32(motion::blocks_free());
+        out::u8(motion::blocks_free());
         out::ch(',');
-        out::u32(hal::serial_rx_free());
+        out::u8(hal::serial_rx_free());
     }
     out::str(LL_PSTR("|FS:"));
     out::rate(motion::current_feed() * 1000u);
     out::str(LL_PSTR(",0"));
     // WCO: in the first report after a reset, right after an offset changed, then every 10th
     // report (every 30th while moving), as GRBL 1.1h.
-    if (gcode::g_state.wco_changed) {
+    if (gcode::g_state.wco_changed || p.wco_countdown == 0) {
         gcode::g_state.wco_changed = 0;
-        p.wco_countdown = 0;
-    }
-    if (p.wco_countdown == 0) {
         out::str(LL_PSTR("|WCO:"));
         out::coords(wco);
         p.wco_countdown = ms == motion::State::Idle ? 9 : 29;
     } else {
         --p.wco_countdown;
     }
-    out::str(LL_PSTR(">\r\n"));
+    out::line(LL_PSTR(">"));
 }
 
 // `$N=value`.
@@ -178,26 +173,22 @@ uint8_t store_setting() {
     return r;
 }
 
-uint8_t system_command() {
+__attribute__((noinline)) uint8_t system_command() {
     const char* s = p.line + 1;
     char c = s[0];
     if (c == 0) {
-        out::str(LL_PSTR("[HLP:$$ $# $G $I $x=val $C $X $RST=$ ~ ! ? ctrl-x]\r\n"));
+        out::line(LL_PSTR("[HLP:$$ $# $G $I $x=val $C $X $RST=$ ~ ! ? ctrl-x]"));
         return kOk;
     }
     bool one_letter = s[1] == 0;
-    switch (c) {
-        case '$':
-            if (!one_letter) return kInvalidStatement;
+    if (c == '$' || c == 'G' || c == 'C' || c == 'X') {
+        if (!one_letter) return kInvalidStatement;
+        if (c == '$') {
             if (!motion_idle()) return kIdleError; // too long to print while moving
             settings::report();
-            return kOk;
-        case 'G':
-            if (!one_letter) return kInvalidStatement;
+        } else if (c == 'G') {
             gcode::report_modes();
-            return kOk;
-        case 'C':
-            if (!one_letter) return kInvalidStatement;
+        } else if (c == 'C') {
             if (p.check) {
                 out::msg(LL_PSTR("Disabled"));
                 return kOkThenReset; // restores the parser state check mode changed
@@ -205,40 +196,34 @@ uint8_t system_command() {
             if (p.alarm || !motion_idle()) return kIdleError;
             p.check = 1;
             out::msg(LL_PSTR("Enabled"));
-            return kOk;
-        case 'X':
-            if (!one_letter) return kInvalidStatement;
-            if (p.alarm) {
-                out::msg(LL_PSTR("Caution: Unlocked"));
-                p.alarm = 0;
-            }
-            return kOk;
-        default:
-            break;
+        } else if (p.alarm) {
+            out::msg(LL_PSTR("Caution: Unlocked"));
+            p.alarm = 0;
+        }
+        return kOk;
     }
     // The rest needs the machine idle (or in alarm), as in GRBL.
     if (p.check || !motion_idle()) return kIdleError;
-    if (c == '#') {
+    if (c == '#' || c == 'I') {
         if (!one_letter) return kInvalidStatement;
-        gcode::report_offsets();
-        return kOk;
-    }
-    if (c == 'I') {
-        if (!one_letter) return kInvalidStatement;
-        out::str(
-            LL_PSTR("[VER:1.1h." LL_BUILD_DATE ":Low Level " LL_VERSION_STRING "]\r\n[OPT:I,"));
-        out::u32(kPlannerSize); // the ring holds kPlannerSize moves
-        out::ch(',');
-        out::u32(p.rx_capacity);
-        out::str(LL_PSTR("]\r\n"));
+        if (c == '#') {
+            gcode::report_offsets();
+        } else {
+            out::str(
+                LL_PSTR("[VER:1.1h." LL_BUILD_DATE ":Low Level " LL_VERSION_STRING "]\r\n[OPT:I,"));
+            out::u8(kPlannerSize); // the ring holds kPlannerSize moves
+            out::ch(',');
+            out::u8(p.rx_capacity);
+            out::line(LL_PSTR("]"));
+        }
         return kOk;
     }
     if (c == 'R') { // $RST=$ settings, $RST=# G54, $RST=* both
-        if (s[1] != 'S' || s[2] != 'T' || s[3] != '=' || s[4] == 0 || s[5] != 0) {
+        char what = s[4];
+        if (s[1] != 'S' || s[2] != 'T' || s[3] != '=' || s[5] != 0 ||
+            (what != '$' && what != '#' && what != '*')) {
             return kInvalidStatement;
         }
-        char what = s[4];
-        if (what != '$' && what != '#' && what != '*') return kInvalidStatement;
         if (what != '#') {
             settings::restore_defaults(); // also zeroes G54
             motion::settings_changed();
@@ -257,24 +242,11 @@ void run_gcode() {
     gcode::Outcome o;
     uint8_t r = gcode::execute(
         p.line, static_cast<uint8_t>(p.gflags | (p.check ? gcode::kCheckMode : 0)), o);
-    switch (r) {
-        case gcode::kRetryWhenAccepting:
-            p.wait = Wait::WhenAccepting;
-            return;
-        case gcode::kRetryWhenIdle:
-            p.wait = Wait::WhenIdle;
-            return;
-        case gcode::kDwell:
-            p.dwell_ms = o.dwell_ms;
-            p.wait = Wait::DwellWhenIdle;
-            return;
-        default:
-            break;
-    }
-    if (r == kOk && o.then == gcode::Then::Pause) {
-        p.wait = Wait::PauseWhenIdle;
-    } else if (r == kOk && o.then == gcode::Then::ProgramEnd) {
-        p.wait = Wait::EndWhenIdle;
+    if (r >= gcode::kRetryWhenAccepting) {
+        p.dwell = o.dwell_ms;
+        p.wait = static_cast<Wait>(r - gcode::kRetryWhenAccepting + uint8_t(Wait::WhenAccepting));
+    } else if (r == kOk && o.then != gcode::Then::Nothing) {
+        p.wait = o.then == gcode::Then::Pause ? Wait::PauseWhenIdle : Wait::EndWhenIdle;
     } else {
         finish(r);
     }
@@ -284,28 +256,21 @@ void run_gcode() {
 void dispatch() {
     uint8_t f = p.flags;
     p.line[p.len] = 0;
-    if (f & kLost) {
-        finish(kOverflow);
-    } else if (f & kBadByte) {
-        finish(kUnsupportedCommand);
-    } else if (f & kTooLong) {
-        finish(kOverflow);
+    if (f & (kLost | kBadByte | kTooLong)) {
+        finish((f & kBadByte) && !(f & kLost) ? kUnsupportedCommand : kOverflow);
     } else if (p.len == 0) {
         finish(kOk); // empty or comment-only line: ok, for the sender's counting
     } else if (p.line[0] == '$') {
         uint8_t r = system_command();
-        if (r == kOkThenReset) {
-            finish(kOk);
-            soft_reset();
-        } else {
-            finish(r);
-        }
+        finish(r == kOkThenReset ? uint8_t(kOk) : r);
+        if (r == kOkThenReset) soft_reset();
     } else if (p.alarm) {
         finish(kGcodeLock);
     } else {
         run_gcode();
     }
-    new_line();
+    p.len = 0;
+    p.flags = 0;
 }
 
 // Takes received bytes until a line is complete (then dispatches it) or none is left.
@@ -322,29 +287,32 @@ void read_line() {
         uint8_t c;
         if (!hal::serial_get(c)) return;
         bool end = false;
+        uint8_t f = p.flags;
         if (c == '\n' || c == '\r') {
             end = !(c == '\n' && p.last_cr); // CR LF is one line end
             p.last_cr = c == '\r';
         } else {
             p.last_cr = 0;
-            if ((c < 0x20 && c != '\t') || c >= 0x7F) {
-                p.flags |= kBadByte; // GRBL drops such bytes and runs the rest; we refuse the line
-            } else if (p.flags & kInSemicolon) {
-            } else if (p.flags & kInParen) {
-                if (c == ')') p.flags &= static_cast<uint8_t>(~kInParen);
-            } else if (c == ' ' || c == '\t' || c == '/') {
-                // spaces, and block delete (ignored, as GRBL does)
+            if (c == '\t') c = ' ';
+            if (c < 0x20 || c >= 0x7F) {
+                f |= kBadByte; // GRBL drops such bytes and runs the rest; we refuse the line
+            } else if (f & kInSemicolon) {
+            } else if (f & kInParen) {
+                if (c == ')') f &= static_cast<uint8_t>(~kInParen);
+            } else if (c == ' ' || c == '/') {
+                // spaces and tabs, and block delete (ignored, as GRBL does)
             } else if (c == '(') {
-                p.flags |= kInParen;
+                f |= kInParen;
             } else if (c == ';') {
-                p.flags |= kInSemicolon;
+                f |= kInSemicolon;
             } else if (p.len >= protocol::kLineMax) {
-                p.flags |= kTooLong;
+                f |= kTooLong;
             } else {
                 if (c >= 'a' && c <= 'z') c = static_cast<uint8_t>(c - ('a' - 'A'));
                 p.line[p.len++] = static_cast<char>(c);
             }
         }
+        p.flags = f;
         if (end) dispatch();
         if (p.lost_after != 0 && --p.lost_after == 0) p.flags |= kLost;
         if (end) return; // one line per run_once()
@@ -352,36 +320,30 @@ void read_line() {
 }
 
 void advance_wait() {
-    switch (p.wait) {
-        case Wait::WhenAccepting:
-            if (motion::can_accept()) run_gcode();
-            break;
-        case Wait::WhenIdle:
-            if (motion_idle()) run_gcode();
-            break;
-        case Wait::DwellWhenIdle:
-            if (motion_idle()) {
-                p.deadline = hal::millis() + p.dwell_ms;
-                p.wait = Wait::Dwell;
-            }
-            break;
-        case Wait::Dwell:
-            if (static_cast<int32_t>(hal::millis() - p.deadline) >= 0) {
-                p.gflags = gcode::kDwellDone;
-                run_gcode();
-            }
-            break;
-        case Wait::PauseWhenIdle:
-            if (motion_idle()) p.wait = Wait::Paused;
-            break;
-        case Wait::EndWhenIdle:
-            if (motion_idle()) {
-                out::msg(LL_PSTR("Pgm End"));
-                finish(kOk);
-            }
-            break;
-        default:
-            break;
+    Wait w = p.wait;
+    if (w == Wait::WhenAccepting) {
+        if (motion::can_accept()) run_gcode();
+        return;
+    }
+    if (w == Wait::Dwell) {
+        if (static_cast<int32_t>(hal::millis() - p.dwell) >= 0) {
+            p.gflags = gcode::kDwellDone;
+            run_gcode();
+        }
+        return;
+    }
+    if (w == Wait::Paused || !motion_idle()) return;
+    // The waits that end once motion is idle.
+    if (w == Wait::WhenIdle) {
+        run_gcode();
+    } else if (w == Wait::DwellWhenIdle) {
+        p.dwell += hal::millis();
+        p.wait = Wait::Dwell;
+    } else if (w == Wait::PauseWhenIdle) {
+        p.wait = Wait::Paused;
+    } else {
+        out::msg(LL_PSTR("Pgm End"));
+        finish(kOk);
     }
 }
 
@@ -392,7 +354,7 @@ namespace protocol {
 void raise_alarm(uint8_t code) {
     p.alarm = 1;
     out::str(LL_PSTR("ALARM:"));
-    out::u32(code);
+    out::u8(code);
     out::eol();
     if (p.wait != Wait::None) finish(kGcodeLock);
 }
@@ -410,14 +372,7 @@ bool idle() {
 namespace app {
 
 void init() {
-    new_line();
-    p.last_cr = 0;
-    p.lost_after = 0;
-    p.gflags = 0;
-    p.wait = Wait::None;
-    p.alarm = 0;
-    p.check = 0;
-    p.wco_countdown = 0;
+    memset(&p, 0, sizeof(p));
     p.rx_capacity = hal::serial_rx_free(); // the buffer is empty at power-up
     if (!settings::load()) {
         // GRBL 1.1h: error:7 ("EEPROM read fail. Using defaults"), then the restored settings.
@@ -426,8 +381,7 @@ void init() {
     }
     motion::init();
     motion::settings_changed();
-    if (!gcode::reset()) out::status(kSettingReadFail);
-    banner();
+    start(false);
 }
 
 void run_once() {

@@ -1,6 +1,9 @@
 // Settings: defaults, EEPROM storage, `$N=value` and `$$`. See settings.h.
 #include "lowlevel/settings.h"
 
+#include <stddef.h>
+#include <string.h>
+
 #include "lowlevel/hal.h"
 #include "lowlevel/print.h"
 #include "lowlevel/status.h"
@@ -13,98 +16,87 @@ namespace {
 static_assert(kEepromSettingsAddr + sizeof(Settings) + 2 <= kEepromCoordAddr,
               "settings record overlaps the G54 record");
 static_assert(kEepromCoordAddr + 4 * kAxes + 2 <= hal::kEepromSize, "EEPROM too small");
+static_assert(sizeof(Settings) < 256, "records are counted in bytes");
 
-// Fletcher-style 16-bit check over a byte range (two running 8-bit sums): catches changed,
-// swapped and zeroed bytes, and a blank (all 0xFF) record never matches its own check.
-uint16_t checksum(const uint8_t* p, uint16_t n) {
+// How a `$` number is stored, checked and printed.
+enum Kind : uint8_t {
+    kByte,     // integer 0..255
+    kBool,     // 0 or 1
+    kPulse,    // integer 3..255 (below 3: error:6, GRBL's minimum)
+    kGroup,    // integer 0..kAxes-1
+    kMilli,    // uint32 thousandths, printed with 3 decimals
+    kMilliPos, // the same, but zero is refused like a negative (a division follows)
+};
+
+// One row per `$` number, in `$$` order; from 100 on, a row is kAxes numbers (one per axis).
+struct Row {
+    uint8_t number;
+    uint8_t kind;
+    uint8_t offset; // offsetof(Settings, field) of the field (of axis 0)
+};
+constexpr uint8_t kFirstAxisNumber = 100;
+
+#define LL_ROW(n, kind, field)                                                                     \
+    { n, kind, static_cast<uint8_t>(offsetof(Settings, field)) }
+const Row kRows[] LL_PROGMEM = {
+    LL_ROW(0, kPulse, pulse_us),
+    LL_ROW(1, kByte, idle_delay_ms),
+    LL_ROW(2, kByte, step_invert),
+    LL_ROW(3, kByte, dir_invert),
+    LL_ROW(4, kBool, enable_invert),
+    LL_ROW(5, kBool, limit_invert),
+    LL_ROW(6, kBool, probe_invert),
+    LL_ROW(10, kByte, status_mask),
+    LL_ROW(11, kMilli, junction_dev),
+    LL_ROW(12, kMilliPos, arc_tolerance), // arcs divide by it
+    LL_ROW(13, kBool, report_inches),
+    LL_ROW(100, kMilliPos, axis[0].steps_per_unit),
+    LL_ROW(110, kMilliPos, axis[0].max_rate),
+    LL_ROW(120, kMilliPos, axis[0].accel),
+    LL_ROW(130, kMilli, axis[0].max_travel),
+    LL_ROW(140, kGroup, axis_group[0]),
+};
+#undef LL_ROW
+constexpr uint8_t kRowCount = sizeof(kRows) / sizeof(kRows[0]);
+
+// The field of `row` for axis `a` (0 for the machine-wide rows).
+uint8_t* field(const Row* row, uint8_t kind, uint8_t a) {
+    uint8_t stride = kind == kGroup ? 1 : sizeof(AxisSettings);
+    return reinterpret_cast<uint8_t*>(&g_settings) + flash_read_byte(&row->offset) +
+           static_cast<uint8_t>(a * stride);
+}
+
+// Fletcher-style 16-bit check over the record (two running 8-bit sums), computed while it is
+// read or written: catches changed, swapped and zeroed bytes, and a blank (all 0xFF) record
+// never matches its own check. Returns true when a read record matches its check.
+bool record(uint16_t addr, void* data, uint8_t n, bool write) {
+    uint8_t* p = static_cast<uint8_t*>(data);
     uint8_t a = 0x5A, b = 0xA5;
-    while (n--) {
-        a = static_cast<uint8_t>(a + *p++);
+    for (uint8_t i = 0; i < n; ++i, ++addr) {
+        if (write) {
+            hal::eeprom_write(addr, p[i]);
+        } else {
+            p[i] = hal::eeprom_read(addr);
+        }
+        a = static_cast<uint8_t>(a + p[i]);
         b = static_cast<uint8_t>(b + a);
     }
-    return static_cast<uint16_t>(b << 8 | a);
-}
-
-void write_record(uint16_t addr, const void* data, uint16_t n) {
-    const uint8_t* p = static_cast<const uint8_t*>(data);
-    for (uint16_t i = 0; i < n; ++i) hal::eeprom_write(static_cast<uint16_t>(addr + i), p[i]);
-    uint16_t sum = checksum(p, n);
-    hal::eeprom_write(static_cast<uint16_t>(addr + n), static_cast<uint8_t>(sum));
-    hal::eeprom_write(static_cast<uint16_t>(addr + n + 1), static_cast<uint8_t>(sum >> 8));
-}
-
-bool read_record(uint16_t addr, void* data, uint16_t n) {
-    uint8_t* p = static_cast<uint8_t*>(data);
-    for (uint16_t i = 0; i < n; ++i) p[i] = hal::eeprom_read(static_cast<uint16_t>(addr + i));
-    uint16_t stored =
-        static_cast<uint16_t>(hal::eeprom_read(static_cast<uint16_t>(addr + n)) |
-                              hal::eeprom_read(static_cast<uint16_t>(addr + n + 1)) << 8);
-    return stored == checksum(p, n);
-}
-
-void save() {
-    hal::eeprom_write(0, kEepromVersion);
-    write_record(kEepromSettingsAddr, &g_settings, sizeof(Settings));
-}
-
-// $N lines for a value in thousandths (printed with 3 decimals) or a small integer.
-void line_prefix(uint8_t n) {
-    out::ch('$');
-    out::u32(n);
-    out::ch('=');
-}
-void line_int(uint8_t n, uint8_t v) {
-    line_prefix(n);
-    out::u32(v);
-    out::eol();
-}
-void line_milli(uint8_t n, uint32_t v) {
-    line_prefix(n);
-    out::fixed(static_cast<int32_t>(v), 3);
-    out::eol();
-}
-
-// The uint8 fields of $0..$6 in setting order (Settings keeps them contiguous).
-uint8_t* byte_setting(uint8_t n) {
-    switch (n) {
-        case 0:
-            return &g_settings.pulse_us;
-        case 1:
-            return &g_settings.idle_delay_ms;
-        case 2:
-            return &g_settings.step_invert;
-        case 3:
-            return &g_settings.dir_invert;
-        case 4:
-            return &g_settings.enable_invert;
-        case 5:
-            return &g_settings.limit_invert;
-        case 6:
-            return &g_settings.probe_invert;
-        case 10:
-            return &g_settings.status_mask;
-        case 13:
-            return &g_settings.report_inches;
-        default:
-            return nullptr;
+    if (write) {
+        hal::eeprom_write(addr, a);
+        hal::eeprom_write(static_cast<uint16_t>(addr + 1), b);
+        return true;
     }
+    return hal::eeprom_read(addr) == a && hal::eeprom_read(static_cast<uint16_t>(addr + 1)) == b;
 }
 
-} // namespace
-
-void restore_defaults() {
-    Settings& s = g_settings;
+// GRBL 1.1h's generic machine, $10=3 and the speed groups X Y Z -> 0, A B C -> 1.
+constexpr Settings make_defaults() {
+    Settings s{};
     s.pulse_us = 10;
     s.idle_delay_ms = 25;
-    s.step_invert = 0;
-    s.dir_invert = 0;
-    s.enable_invert = 0;
-    s.limit_invert = 0;
-    s.probe_invert = 0;
     s.status_mask = 3; // MPos and Bf: (GRBL 1.1h: 1, MPos only; see docs/protocol.md)
     s.junction_dev = 10;
     s.arc_tolerance = 2;
-    s.report_inches = 0;
     for (uint8_t a = 0; a < kAxes; ++a) {
         s.axis_group[a] = a < 3 ? 0 : 1;
         s.axis[a].steps_per_unit = 250000;
@@ -112,6 +104,19 @@ void restore_defaults() {
         s.axis[a].accel = 10000;
         s.axis[a].max_travel = 200000;
     }
+    return s;
+}
+const Settings kDefaults LL_PROGMEM = make_defaults();
+
+void save() {
+    hal::eeprom_write(0, kEepromVersion);
+    record(kEepromSettingsAddr, &g_settings, sizeof(Settings), true);
+}
+
+} // namespace
+
+void restore_defaults() {
+    flash_copy(&g_settings, &kDefaults, sizeof(Settings));
     save();
     int32_t zero[kAxes] = {};
     save_coord(zero);
@@ -119,7 +124,7 @@ void restore_defaults() {
 
 bool load() {
     if (hal::eeprom_read(0) == kEepromVersion &&
-        read_record(kEepromSettingsAddr, &g_settings, sizeof(Settings))) {
+        record(kEepromSettingsAddr, &g_settings, sizeof(Settings), false)) {
         return true;
     }
     restore_defaults();
@@ -127,91 +132,60 @@ bool load() {
 }
 
 bool load_coord(int32_t (&um)[kAxes]) {
-    if (read_record(kEepromCoordAddr, um, sizeof(um))) return true;
-    for (uint8_t a = 0; a < kAxes; ++a) um[a] = 0;
+    if (record(kEepromCoordAddr, um, sizeof(um), false)) return true;
+    memset(um, 0, sizeof(um));
     save_coord(um);
     return false;
 }
 
 void save_coord(const int32_t (&um)[kAxes]) {
-    write_record(kEepromCoordAddr, um, sizeof(um));
+    record(kEepromCoordAddr, const_cast<int32_t*>(um), sizeof(um), true);
 }
 
 uint8_t store(uint8_t n, const num::Decimal& value) {
     if (value.negative()) return status::kNegativeValue;
-    if (n >= 100) {
-        uint8_t kind = static_cast<uint8_t>((n - 100) / 10);
-        uint8_t a = static_cast<uint8_t>((n - 100) % 10);
-        if (kind > 4 || a >= kAxes) return status::kInvalidStatement;
-        if (kind == 4) { // $140+a: speed group, an integer 0..kAxes-1
-            uint32_t g;
-            if (!num::to_uint(value, kAxes - 1u, g)) return status::kInvalidStatement;
-            g_settings.axis_group[a] = static_cast<uint8_t>(g);
-        } else {
+    for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
+        uint8_t first = flash_read_byte(&row->number);
+        uint8_t a = static_cast<uint8_t>(n - first);
+        if (a >= (first >= kFirstAxisNumber ? kAxes : 1)) continue;
+        uint8_t kind = flash_read_byte(&row->kind);
+        uint8_t* f = field(row, kind, a);
+        if (kind >= kMilli) {
             int32_t milli;
             if (!num::to_milli(value, milli)) return status::kInvalidStatement;
-            // Steps, rates and accelerations divide later: zero is refused like a negative.
-            if (milli == 0 && kind != 3) return status::kNegativeValue;
-            uint32_t v = static_cast<uint32_t>(milli);
-            AxisSettings& ax = g_settings.axis[a];
-            if (kind == 0) ax.steps_per_unit = v;
-            if (kind == 1) ax.max_rate = v;
-            if (kind == 2) ax.accel = v;
-            if (kind == 3) ax.max_travel = v;
-        }
-    } else if (n == 11 || n == 12) {
-        int32_t milli;
-        if (!num::to_milli(value, milli)) return status::kInvalidStatement;
-        if (n == 11) {
-            g_settings.junction_dev = static_cast<uint32_t>(milli);
+            if (milli == 0 && kind == kMilliPos) return status::kNegativeValue;
+            memcpy(f, &milli, sizeof(milli));
         } else {
-            if (milli == 0) return status::kNegativeValue; // arcs divide by it
-            g_settings.arc_tolerance = static_cast<uint32_t>(milli);
+            uint32_t v;
+            uint8_t max = kind == kBool ? 1 : kind == kGroup ? kAxes - 1 : 255;
+            if (!num::to_uint(value, max, v)) return status::kInvalidStatement;
+            if (kind == kPulse && v < 3) return status::kStepPulseMin;
+            *f = static_cast<uint8_t>(v);
         }
-    } else {
-        uint8_t* field = byte_setting(n);
-        if (field == nullptr) return status::kInvalidStatement;
-        // Booleans are 0 or 1; masks, times and $10 are bytes.
-        uint32_t max = (n >= 4 && n <= 6) || n == 13 ? 1u : 255u;
-        uint32_t v;
-        if (!num::to_uint(value, max, v)) return status::kInvalidStatement;
-        if (n == 0 && v < 3) return status::kStepPulseMin;
-        *field = static_cast<uint8_t>(v);
+        save();
+        return status::kOk;
     }
-    save();
-    return status::kOk;
+    return status::kInvalidStatement;
 }
 
 void report() {
-    static const uint8_t kByteOrder[8] LL_PROGMEM = {0, 1, 2, 3, 4, 5, 6, 10};
-    for (uint8_t i = 0; i < sizeof(kByteOrder); ++i) {
-        uint8_t n = flash_read_byte(&kByteOrder[i]);
-        line_int(n, *byte_setting(n));
-    }
-    line_milli(11, g_settings.junction_dev);
-    line_milli(12, g_settings.arc_tolerance);
-    line_int(13, g_settings.report_inches);
-    for (uint8_t kind = 0; kind < 5; ++kind) {
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            uint8_t n = static_cast<uint8_t>(100 + kind * 10 + a);
-            const AxisSettings& ax = g_settings.axis[a];
-            switch (kind) {
-                case 0:
-                    line_milli(n, ax.steps_per_unit);
-                    break;
-                case 1:
-                    line_milli(n, ax.max_rate);
-                    break;
-                case 2:
-                    line_milli(n, ax.accel);
-                    break;
-                case 3:
-                    line_milli(n, ax.max_travel);
-                    break;
-                default:
-                    line_int(n, g_settings.axis_group[a]);
-                    break;
+    for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
+        uint8_t first = flash_read_byte(&row->number);
+        uint8_t kind = flash_read_byte(&row->kind);
+        uint8_t count = first >= kFirstAxisNumber ? kAxes : 1;
+        for (uint8_t a = 0; a < count; ++a) {
+            const uint8_t* f = field(row, kind, a);
+            out::ch('$');
+            out::u8(static_cast<uint8_t>(first + a));
+            out::ch('=');
+            if (kind >= kMilli) {
+                int32_t milli;
+                memcpy(&milli, f, sizeof(milli));
+                out::fixed(milli, 3);
+            } else {
+                out::u8(*f);
             }
+            out::eol();
         }
     }
 }

@@ -5,6 +5,8 @@
 #pragma once
 
 #include "lowlevel/config.h"
+#include "lowlevel/numparse.h"
+#include "lowlevel/settings.h"
 
 namespace ll {
 namespace gcode {
@@ -22,6 +24,7 @@ enum class Motion : uint8_t {
     None,       ///< G80
 };
 
+/// One byte per modal group, in the order of gcode.cpp's group numbers (it copies them as bytes).
 struct Modal {
     Motion motion;
     uint8_t plane;       ///< 0 = G17 (XY), 1 = G18 (ZX), 2 = G19 (YZ)
@@ -32,11 +35,13 @@ struct Modal {
     uint8_t coolant;     ///< 8 or 9 (M8/M9): tracked and reported, no output yet
 };
 
+/// execute() copies modal + tool (8 bytes) and feed, spindle_speed, line_number as 32-bit words:
+/// keep them in this order (static_asserts in gcode.cpp).
 struct State {
     Modal modal;
+    uint8_t tool;                  ///< T
     uint32_t feed;                 ///< F, mm/min x1000 (deg/min x1000); 0 = undefined
     uint32_t spindle_speed;        ///< S, rpm
-    uint8_t tool;                  ///< T
     uint32_t line_number;          ///< N of the last executed line (0 without N)
     int32_t position[kAxes];       ///< machine position of the last target, um
     int32_t position_steps[kAxes]; ///< the same in steps, exactly as sent to the planner
@@ -84,6 +89,9 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome);
 bool reset();
 /// Takes the parser position from motion::position() (after an abort).
 void sync_position();
+/// Machine steps to um, per axis (`steps` and `um` may be the same array): exact, rounded half
+/// away from zero, saturated on overflow.
+void steps_to_um(const int32_t* steps, int32_t* um);
 /// Steps per unit changed: recomputes position_steps from the um position (GRBL keeps the mm).
 void settings_changed();
 
@@ -94,8 +102,14 @@ void report_offsets();
 /// Work coordinate offset (G54 + G92), um.
 void work_offset(int32_t (&um)[kAxes]);
 
-/// round_half_away_from_zero(um * steps_per_unit_milli / 10^6), exact. False on overflow.
-bool um_to_steps(uint8_t axis, int32_t um, int32_t& steps);
+/// round_half_away_from_zero(um * steps_per_unit_milli / 10^6), exact. False (and `steps`
+/// unchanged) when the result does not fit an int32.
+inline bool um_to_steps(uint8_t axis, int32_t um, int32_t& steps) {
+    int32_t s;
+    if (!num::mul_div_round(um, g_settings.axis[axis].steps_per_unit, 1000000u, s)) return false;
+    steps = s;
+    return true;
+}
 
 } // namespace gcode
 } // namespace ll

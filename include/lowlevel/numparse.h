@@ -32,27 +32,36 @@ struct Decimal {
     bool integral() const { return frac == 0 && sub == 0 && (flags & kInexact) == 0; }
 };
 
-/// Reads `[+|-]digits[.digits]` (at least one digit; GRBL's read_float without its float) from
-/// `s` at `pos` and advances `pos` past it. Returns false when no digit is present or the integer
+/// Reads `[+|-]digits[.digits]` (at least one digit; GRBL's read_float without its float) at
+/// `p`. Returns the character after it, or nullptr when no digit is present or the integer
 /// part has more than 9 digits.
-bool parse(const char* s, uint8_t& pos, Decimal& out);
+const char* parse(const char* p, Decimal& out);
+/// The same with a position in `s`, advanced past the number (unchanged on failure).
+inline bool parse(const char* s, uint8_t& pos, Decimal& out) {
+    const char* end = parse(s + pos, out);
+    if (end == nullptr) return false;
+    pos = static_cast<uint8_t>(end - s);
+    return true;
+}
 
+/// inch_to_milli() when `inches`, else to_milli(): a length or feed in the units of a block.
+bool length_to_milli(const Decimal& d, bool inches, int32_t& out);
 /// value x1000, half away from zero. False when |value x1000| would exceed INT32_MAX.
-bool to_milli(const Decimal& d, int32_t& out);
+inline bool to_milli(const Decimal& d, int32_t& out) {
+    return length_to_milli(d, false, out);
+}
 /// value x25400 (inches to um), see above. False when the result would exceed INT32_MAX.
-bool inch_to_milli(const Decimal& d, int32_t& out);
+inline bool inch_to_milli(const Decimal& d, int32_t& out) {
+    return length_to_milli(d, true, out);
+}
 /// The value as an integer in [0, max]. False when negative, not integral or above max.
 bool to_uint(const Decimal& d, uint32_t max, uint32_t& out);
 
-/// round_half_away_from_zero(a * b / c), exactly, with 32-bit pieces only (no 64-bit division
-/// on the chip: a 32-step restoring division). Preconditions: 0 < c < 2^31. Returns false (and
-/// saturates `out`) when the result does not fit in an int32.
+/// round_half_away_from_zero(a * b / c), exactly: one 32x32->64 product and a restoring
+/// division that skips leading zero quotient bytes (no 64-bit library division on the chip).
+/// Preconditions: 0 < c < 2^31. Returns false (and saturates `out`) when the result does not
+/// fit in an int32 (INT32_MIN included: only magnitudes up to INT32_MAX are produced).
 bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out);
-
-/// The 64-bit product a * b as two halves.
-void mul64(uint32_t a, uint32_t b, uint32_t& hi, uint32_t& lo);
-/// (hi:lo) / c and its remainder. Preconditions: 0 < c < 2^31 and hi < c (the quotient fits).
-uint32_t div64(uint32_t hi, uint32_t lo, uint32_t c, uint32_t& rem);
 
 } // namespace num
 } // namespace ll

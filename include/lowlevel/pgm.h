@@ -40,4 +40,11 @@ inline uint32_t flash_read_u32(const uint32_t* p) {
 #endif
 }
 
+/// Copies `n` bytes from flash to RAM.
+inline void flash_copy(void* dst, const void* src, uint8_t n) {
+    uint8_t* d = static_cast<uint8_t*>(dst);
+    const uint8_t* s = static_cast<const uint8_t*>(src);
+    while (n--) *d++ = flash_read_byte(s++);
+}
+
 } // namespace ll

@@ -16,13 +16,21 @@ void ch(char c);
 void str(const FlashChar* s);
 /// "\r\n", GRBL's line end.
 void eol();
+/// A string kept in flash, then the line end.
+void line(const FlashChar* s);
 /// An unsigned integer in decimal.
 void u32(uint32_t v);
+/// The same for a byte (a shorter call).
+void u8(uint8_t v);
+/// ' ', `letter`, then `v` in decimal: one word of `$G`.
+void word(char letter, uint8_t v);
 /// A fixed-point value `v` scaled by 10^decimals, printed with exactly `decimals` decimals:
 /// fixed(-1500, 3) prints "-1.500", fixed(7, 3) prints "0.007". decimals <= 9.
 void fixed(int32_t v, uint8_t decimals);
-/// kAxes coordinates separated by commas: um printed as mm with 3 decimals, or as inches with
-/// 4 decimals when $13=1 (exact conversion, half away from zero).
+/// One length in um printed as mm with 3 decimals, or as inches with 4 decimals when $13=1
+/// (exact conversion, half away from zero).
+void coord(int32_t um);
+/// kAxes lengths (coord()) separated by commas; nullptr prints zeros.
 void coords(const int32_t* um);
 /// A rate given in units/min x1000: mm/min without decimals, or in/min with 1 decimal ($13=1),
 /// as GRBL prints F and FS.
