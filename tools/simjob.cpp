@@ -110,10 +110,15 @@ size_t Host::take() {
 bool Host::wait_banner(uint64_t max_cycles) {
     const uint64_t limit = sim_.deadline(max_cycles);
     for (;;) {
-        const size_t seen = others_.size();
-        take();
-        for (size_t i = seen; i < others_.size(); ++i)
-            if (others_[i].text.compare(0, 5, "Grbl ") == 0) return true;
+        // Everything up to the banner answers no line of ours (a blank EEPROM prints error:7).
+        const std::vector<OutputLine>& all = sim_.output_lines();
+        for (; cursor_ < all.size(); ++cursor_) {
+            others_.push_back(all[cursor_]);
+            if (all[cursor_].text.compare(0, 5, "Grbl ") == 0) {
+                ++cursor_;
+                return true;
+            }
+        }
         if (sim_.cycle() >= limit) return false;
         const size_t n = sim_.output_lines().size();
         run_until([&] { return sim_.output_lines().size() != n; }, limit - sim_.cycle());
