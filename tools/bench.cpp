@@ -368,6 +368,11 @@ const FnList kPlannerFns = {
     {"_ZN2ll7isqrt32Em", "isqrt32"},
     {"__udivmodsi4", "__udivmodsi4 (32-bit division)"},
     {"_ZN2ll6motion4pollEv", "motion::poll (step generation)"},
+    {"_ZNK2ll7Planner13spec_of_firstEv", "Planner::spec_of_first"},
+    {"_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "StepGen::begin"},
+    {"_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE", "StepGen::fill"},
+    {"_ZN2ll3hal10serial_putEh", "hal::serial_put"},
+    {"_ZN2ll3app8run_onceEv", "app::run_once (the whole main loop)"},
 };
 
 // ---- circle of short segments -------------------------------------------------------------
@@ -403,7 +408,6 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
     c.lines = job.size();
     std::unique_ptr<Profiler> prof;
     const std::string kExecute = "_ZN2ll5gcode7executeEPKchRNS0_7OutcomeE";
-    const std::string kPoll = "_ZN2ll6motion4pollEv";
     const std::string kAdd = "_ZN2ll7Planner3addEPKlS2_mb";
     if (profile) {
         std::vector<std::string> syms;
@@ -439,8 +443,15 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
         c.worst_dev = std::max(c.worst_dev, std::fabs(std::hypot(p[0] - cx, p[1]) - r));
     if (prof) {
         c.profiled = true;
-        const int fe = prof->index_of(kExecute), fp = prof->index_of(kPoll),
-                  fa = prof->index_of(kAdd);
+        // Step generation: motion::poll and what it runs, also where push_line inlines it.
+        std::vector<bool> is_gen(kPlannerFns.size(), false);
+        for (const char* g :
+             {"_ZN2ll6motion4pollEv", "_ZNK2ll7Planner13spec_of_firstEv",
+              "_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE"}) {
+            const int k = prof->index_of(g);
+            if (k >= 0) is_gen[static_cast<size_t>(k)] = true;
+        }
+        const int fe = prof->index_of(kExecute), fa = prof->index_of(kAdd);
         const std::vector<Profiler::Call>& calls = prof->calls();
         std::vector<uint64_t> exec_own(calls.size(), 0);
         std::vector<bool> queued(calls.size(), false);
@@ -451,17 +462,17 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
             if (!k.end || k.start < job_start) continue;
             const uint64_t own = prof->own_cycles(k);
             if (k.fn == fe) exec_own[i] += own;
-            // Charge nested calls to the innermost enclosing execute.
-            int p = k.parent;
-            while (p >= 0 && calls[static_cast<size_t>(p)].fn != fe)
-                p = calls[static_cast<size_t>(p)].parent;
-            if (k.fn == fp) {
-                if (p < 0)
-                    poll_total += own; // step generation from the main loop
-                else {
-                    exec_own[static_cast<size_t>(p)] -= own;
-                    poll_total += own;
-                }
+            // The innermost enclosing execute, and whether step generation encloses this call.
+            int p = -1;
+            bool inside_gen = false;
+            for (int q = k.parent; q >= 0; q = calls[static_cast<size_t>(q)].parent) {
+                if (is_gen[static_cast<size_t>(calls[static_cast<size_t>(q)].fn)])
+                    inside_gen = true;
+                if (p < 0 && calls[static_cast<size_t>(q)].fn == fe) p = q;
+            }
+            if (is_gen[static_cast<size_t>(k.fn)] && !inside_gen) {
+                poll_total += own;
+                if (p >= 0) exec_own[static_cast<size_t>(p)] -= own;
             }
             if (k.fn == fa) {
                 adds.push_back(own);
@@ -478,7 +489,6 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
         c.planner_add = stats_of(adds);
         c.parse_plan_per_line = static_cast<double>(all_exec) / static_cast<double>(c.lines);
         const double motion_cycles = static_cast<double>(t.last() - t.first());
-        // Nested poll calls were charged above; count each once.
         c.producer_share = static_cast<double>(poll_total) / motion_cycles;
         uint64_t isr = 0;
         std::vector<uint64_t> a_spans;

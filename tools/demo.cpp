@@ -237,7 +237,8 @@ std::string svg_of(const Trace& t, const Follow& f, const Picture& pic) {
         const auto& p = t.pos[i];
         std::array<int32_t, kTraceAxes> delta;
         for (int a = 0; a < kTraceAxes; ++a)
-            delta[static_cast<size_t>(a)] = p[static_cast<size_t>(a)] - prev[static_cast<size_t>(a)];
+            delta[static_cast<size_t>(a)] =
+                p[static_cast<size_t>(a)] - prev[static_cast<size_t>(a)];
         if (r != rapid) {
             flush(pts, rapid);
             rapid = r;
@@ -353,7 +354,8 @@ int main(int argc, char** argv) {
                              i < lines.size() ? lines[i].c_str() : "?", answers[i].text.c_str());
         }
         std::cout << fmt("   %zu lines sent: %zu ok, %zu error%s\n", host.answered(), oks,
-                         answers.size() - oks, stalled ? " -- then the firmware stopped answering" : "");
+                         answers.size() - oks,
+                         stalled ? " -- then the firmware stopped answering" : "");
         for (const OutputLine& o : host.others()) {
             if (o.cycle < t0) continue;
             std::cout << fmt("   %7.3f s  %s\n", static_cast<double>(o.cycle - t0) / 16e6,
@@ -369,7 +371,8 @@ int main(int argc, char** argv) {
                 per_mm[l[3] - '0'] = atof(l.c_str() + 5);
         size_t rapids = 0;
         for (const Move& m : moves) rapids += m.rapid;
-        const double motion = t.cycle.empty() ? 0 : static_cast<double>(t.last() - t.first()) / 16e6;
+        const double motion =
+            t.cycle.empty() ? 0 : static_cast<double>(t.last() - t.first()) / 16e6;
         const uint16_t starved = static_cast<uint16_t>(peek_var(sim, "_ZN2ll13g_starvationsE", 2));
 
         std::vector<std::string> summary;

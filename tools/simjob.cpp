@@ -198,16 +198,21 @@ Profiler::Profiler(Sim& sim, const std::vector<std::string>& symbols)
 void Profiler::step() {
     avr_t* a = sim_.avr();
     const uint16_t sp = static_cast<uint16_t>(a->data[kSpl] | (a->data[kSph] << 8));
-    while (!stack_.empty() && sp > stack_.back().sp) {
+    // Returned: the stack pointer is above the frame and the CPU is at its return address. The
+    // address matters: SP is written one byte at a time (SPH, then SPL), so while a frame is
+    // released it can read above its final value for one instruction.
+    while (!stack_.empty() && sp > stack_.back().sp && a->pc == stack_.back().ret) {
         calls_[static_cast<size_t>(stack_.back().call)].end = a->cycle;
         stack_.pop_back();
     }
     const uint32_t word = a->pc / 2;
     if (word < fn_at_.size() && fn_at_[word] >= 0) {
-        // A tail call arrives with the caller's stack pointer: it is nested all the same.
+        // A tail call arrives with the caller's stack pointer and return address: it is nested
+        // all the same and both end at the same return.
         const int parent = stack_.empty() ? -1 : stack_.back().call;
+        const uint32_t ret = 2u * ((static_cast<uint32_t>(a->data[sp + 1]) << 8) | a->data[sp + 2]);
         calls_.push_back(Call{fn_at_[word], parent, a->cycle, 0});
-        stack_.push_back(Frame{static_cast<int>(calls_.size() - 1), sp});
+        stack_.push_back(Frame{static_cast<int>(calls_.size() - 1), sp, ret});
     }
 }
 

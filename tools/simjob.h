@@ -89,8 +89,8 @@ class Host {
 /// Inclusive call timings of chosen functions, found by ELF symbol. Call `step()` after every
 /// instruction (Host::hook). A call starts when the program counter reaches the function's
 /// first instruction and ends when the stack pointer climbs above its value at that moment
-/// (the return address popped). Interrupts that run during a call are recorded separately
-/// (`isr_cycles_in`) so that they can be taken out.
+/// (the return address popped) with the program counter at that return address. Interrupts that
+/// run during a call are recorded separately (`isr_cycles_in`) so that they can be taken out.
 class Profiler {
   public:
     struct Call {
@@ -117,7 +117,8 @@ class Profiler {
   private:
     struct Frame {
         int call;
-        uint16_t sp;
+        uint16_t sp;  ///< stack pointer at the function's first instruction
+        uint32_t ret; ///< return address (flash byte address)
     };
     sim::Sim& sim_;
     std::vector<std::string> names_;
