@@ -4,6 +4,8 @@
 set -euo pipefail
 pkgs=(cmake make g++ gcc-avr avr-libc binutils-avr avrdude simavr libsimavr-dev libelf-dev
       libgtest-dev pkg-config)
+# The demo also renders its SVG picture to PNG.
+[ "${1:-}" = demo ] && pkgs+=(librsvg2-bin)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,0 +1,839 @@
+// llbench: the performance figures of docs/benchmarks.md, measured on the real firmware images
+// in simavr (sim/), from exact cycle counts. Deterministic: the same images give the same output.
+//
+//   build/host/tools/llbench                 # every figure (about a minute)
+//   build/host/tools/llbench --quick         # a tiny configuration (smoke test)
+//   build/host/tools/llbench --only circle   # one group: rate, isr, circle, size, ceiling
+//
+// Nothing here is a pass/fail test: the program prints figures and whether each goal is met,
+// and exits 0 unless a run could not be carried out (firmware missing, no banner, ...).
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "harness.h"
+#include "simjob.h"
+
+using namespace ll::sim;
+using namespace ll::tools;
+
+#ifndef LLBENCH_FIRMWARE_DIR
+#define LLBENCH_FIRMWARE_DIR "build/avr/firmware"
+#endif
+
+namespace {
+
+constexpr double kCpu = 16e6;
+constexpr double kPi = 3.14159265358979323846;
+
+struct Config {
+    std::string elf = std::string(LLBENCH_FIRMWARE_DIR) + "/lowlevel.elf";
+    std::string bench_elf = std::string(LLBENCH_FIRMWARE_DIR) + "/lowlevel_bench.elf";
+    bool quick = false;
+    bool verbose = false;
+    std::set<std::string> only;
+    bool want(const std::string& g) const { return only.empty() || only.count(g); }
+};
+
+std::string fmt(const char* f, ...) __attribute__((format(printf, 1, 2)));
+std::string fmt(const char* f, ...) {
+    char buf[512];
+    va_list ap;
+    va_start(ap, f);
+    vsnprintf(buf, sizeof buf, f, ap);
+    va_end(ap);
+    return buf;
+}
+
+std::string thousands(double v) {
+    const long long n = std::llround(v);
+    std::string s = std::to_string(n < 0 ? -n : n), out;
+    for (size_t i = 0; i < s.size(); ++i) {
+        if (i && (s.size() - i) % 3 == 0) out += ',';
+        out += s[i];
+    }
+    return (n < 0 ? "-" : "") + out;
+}
+
+[[noreturn]] void fail(const std::string& msg) {
+    std::cerr << "llbench: " << msg << '\n';
+    exit(1);
+}
+
+/// Deepest stack seen by any Board so far, and how many runs reached the end of .bss.
+unsigned g_stack_peak = 0;
+unsigned g_static_end = 0;
+int g_stack_overflows = 0;
+int g_boards = 0;
+
+/// A fresh chip running `elf`, booted to its banner (blank EEPROM: GRBL's defaults restored),
+/// with its free RAM painted to find the deepest stack of the run.
+struct Board {
+    Sim sim;
+    Host host;
+    std::unique_ptr<StackProbe> stack;
+    explicit Board(const std::string& elf) : sim(elf), host(sim) {
+        if (!host.wait_banner(ms(3000))) fail("no GRBL banner from " + elf);
+        stack.reset(new StackProbe(sim));
+    }
+    ~Board() {
+        ++g_boards;
+        g_stack_peak = std::max(g_stack_peak, stack->peak());
+        g_static_end = stack->static_end();
+        if (stack->overflowed()) ++g_stack_overflows;
+    }
+    void settings(const std::vector<std::string>& lines) {
+        for (const std::string& l : lines) {
+            const int r = host.send_line(l, ms(1000));
+            if (r != 0) fail(fmt("\"%s\" answered %d", l.c_str(), r));
+        }
+    }
+    uint16_t starvations() const {
+        return static_cast<uint16_t>(peek_var(sim, "_ZN2ll13g_starvationsE", 2));
+    }
+    bool running() const { return peek_var(sim, "_ZN2ll6g_execE", 1, 3) != 0; }
+};
+
+/// "G1 ..." with a feed of `f` mm/min, 3 decimals as the firmware keeps it.
+std::string feed_word(double f) {
+    return fmt("F%.3f", std::floor(f * 1000) / 1000);
+}
+
+// ---- maximum step rate --------------------------------------------------------------------
+
+struct RateRun {
+    double requested = 0;   ///< steps/s per axis
+    double period = 0;      ///< the matching period, cycles
+    bool count_ok = false;  ///< every axis made exactly the steps asked
+    std::string count_note; ///< what went wrong with the count
+    size_t cruise_n = 0;    ///< intervals in the cruise window
+    uint64_t median = 0;    ///< median cruise interval, cycles
+    uint64_t worst = 0;     ///< longest interval inside the cruise window
+    uint64_t longest = 0;   ///< longest interval of the whole move (acceleration included)
+    int64_t jitter_lo = 0, jitter_hi = 0; ///< cruise intervals minus the median, gaps excluded
+    size_t gaps = 0;                      ///< cruise intervals above 1.5x the median
+    uint16_t starvations = 0;
+    bool stack_overflow = false;
+    bool reached = false; ///< the cruise median is the requested period (within 2 %)
+    bool clean = false;
+    // Step interrupt (only when asked): spans in the cruise window.
+    Stats compa, compb, per_step;
+    double isr_share = 0; ///< step interrupt cycles / cruise window cycles
+    uint64_t window = 0;
+};
+
+/// One move of `mm` on `axes` axes (X, XY or XYZ, equal distances) at `rate` steps/s per axis,
+/// 1000 steps/mm, 2000 mm/s², $0 = 3 µs.
+RateRun rate_run(const Config& cfg, int axes, double rate, double mm, bool poll_status,
+                 bool time_isr) {
+    RateRun r;
+    r.requested = rate;
+    r.period = kCpu / rate;
+    Board b(cfg.elf);
+    std::vector<std::string> set = {"$0=3"};
+    for (int a = 0; a < axes; ++a) {
+        set.push_back(fmt("$%d=1000", 100 + a));
+        set.push_back(fmt("$%d=300000", 110 + a));
+        set.push_back(fmt("$%d=2000", 120 + a));
+    }
+    b.settings(set);
+    b.settings({"G91"});
+    if (time_isr) {
+        b.sim.record_isr(11);
+        b.sim.record_isr(12);
+    }
+    const double feed = rate * 60.0 / 1000.0 * std::sqrt(static_cast<double>(axes));
+    std::string line = "G1";
+    for (int a = 0; a < axes; ++a) line += fmt("%c%.3f", "XYZ"[a], mm);
+    line += feed_word(feed);
+    const uint64_t t0 = b.sim.cycle();
+    if (poll_status) b.sim.send_every('?', t0 + ms(50), ms(50));
+    if (b.host.send_line(line, ms(1000)) != 0) fail("move refused: " + line);
+    const uint64_t expected = static_cast<uint64_t>(std::llround(mm * 1000));
+    const double seconds = expected / rate + 2 * (rate / 1000.0) / 2000.0;
+    const uint64_t timeout = b.sim.cycle() + static_cast<uint64_t>((seconds * 2 + 0.5) * kCpu);
+    size_t last_edges = 0;
+    uint64_t quiet_since = b.sim.cycle();
+    while (b.sim.cycle() < timeout) {
+        b.sim.run_for(ms(5));
+        const size_t n = b.sim.edges().size();
+        if (n != last_edges) {
+            last_edges = n;
+            quiet_since = b.sim.cycle();
+        } else if (b.sim.cycle() - quiet_since >= ms(40) && !b.running()) {
+            break;
+        }
+    }
+    r.starvations = b.starvations();
+    r.stack_overflow = b.stack->overflowed();
+    const Trace t = trace_steps(b.sim);
+    r.count_ok = true;
+    for (int a = 0; a < kTraceAxes; ++a) {
+        const uint64_t want = a < axes ? expected : 0;
+        if (t.steps(a) != want ||
+            t.final_pos[static_cast<size_t>(a)] != static_cast<int32_t>(want)) {
+            r.count_ok = false;
+            r.count_note +=
+                fmt(" %c:%llu/%llu", "XYZA"[a], static_cast<unsigned long long>(t.steps(a)),
+                    static_cast<unsigned long long>(want));
+        }
+    }
+    // Cruise window: from the first to the last interval at (or below) the requested period.
+    const std::vector<uint64_t>& e = t.edges[0];
+    std::vector<uint64_t> d;
+    for (size_t i = 1; i < e.size(); ++i) d.push_back(e[i] - e[i - 1]);
+    size_t lo = d.size(), hi = 0;
+    for (size_t i = 0; i < d.size(); ++i) {
+        r.longest = std::max(r.longest, d[i]);
+        if (d[i] <= r.period * 1.02) {
+            lo = std::min(lo, i);
+            hi = i;
+        }
+    }
+    if (lo <= hi && lo < d.size()) {
+        std::vector<uint64_t> cruise(d.begin() + static_cast<long>(lo),
+                                     d.begin() + static_cast<long>(hi) + 1);
+        // Every axis must be clean, not only X.
+        for (int a = 1; a < axes; ++a) {
+            const std::vector<uint64_t>& ea = t.edges[static_cast<size_t>(a)];
+            for (size_t i = lo + 1; i <= hi + 1 && i < ea.size(); ++i)
+                cruise.push_back(ea[i] - ea[i - 1]);
+        }
+        const Stats s = stats_of(cruise);
+        r.cruise_n = s.n;
+        r.median = s.median;
+        r.worst = s.max;
+        // Jitter of the regular intervals; the gaps (> 1.5x the median) are counted apart.
+        std::vector<uint64_t> regular;
+        for (uint64_t x : cruise) {
+            if (static_cast<double>(x) > 1.5 * static_cast<double>(s.median))
+                ++r.gaps;
+            else
+                regular.push_back(x);
+        }
+        const Stats g = stats_of(regular);
+        r.jitter_lo = static_cast<int64_t>(g.min) - static_cast<int64_t>(s.median);
+        r.jitter_hi = static_cast<int64_t>(g.max) - static_cast<int64_t>(s.median);
+        r.reached = std::fabs(static_cast<double>(s.median) - r.period) <= 0.02 * r.period;
+        if (time_isr) {
+            const uint64_t w0 = e[lo], w1 = e[hi + 1];
+            r.window = w1 - w0;
+            std::vector<uint64_t> a_spans, b_spans;
+            uint64_t busy = 0;
+            for (const IsrSpan& sp : b.sim.isr_spans()) {
+                if (sp.accepted < w0 || !sp.returned || sp.returned > w1) continue;
+                const uint64_t len = sp.returned - sp.accepted;
+                if (sp.vector == 11) a_spans.push_back(len);
+                if (sp.vector == 12) b_spans.push_back(len);
+                if (sp.vector == 11 || sp.vector == 12) busy += len;
+            }
+            r.compa = stats_of(a_spans);
+            r.compb = stats_of(b_spans);
+            r.isr_share = static_cast<double>(busy) / static_cast<double>(r.window);
+            // Per step: COMPA + the COMPB that follows it (a run's last event has no COMPB).
+            std::vector<uint64_t> per;
+            const std::vector<IsrSpan>& sp = b.sim.isr_spans();
+            for (size_t i = 0; i < sp.size(); ++i) {
+                if (sp[i].vector != 11 || sp[i].accepted < w0 || sp[i].accepted >= w1) continue;
+                uint64_t c = sp[i].returned - sp[i].accepted;
+                if (i + 1 < sp.size() && sp[i + 1].vector == 12)
+                    c += sp[i + 1].returned - sp[i + 1].accepted;
+                per.push_back(c);
+            }
+            r.per_step = stats_of(per);
+        }
+    }
+    r.clean = r.count_ok && r.cruise_n > 0 && r.reached && r.starvations == 0 &&
+              !r.stack_overflow &&
+              static_cast<double>(r.worst) <= 1.5 * static_cast<double>(r.median);
+    return r;
+}
+
+std::string describe(const RateRun& r) {
+    std::string s = fmt("%7s steps/s  period %6.1f  ", thousands(r.requested).c_str(), r.period);
+    if (r.cruise_n)
+        s +=
+            fmt("cruise median %4llu  max %6llu (%.2fx)  gaps %3zu  jitter %+lld/%+lld",
+                static_cast<unsigned long long>(r.median), static_cast<unsigned long long>(r.worst),
+                static_cast<double>(r.worst) / static_cast<double>(r.median), r.gaps,
+                static_cast<long long>(r.jitter_lo), static_cast<long long>(r.jitter_hi));
+    else
+        s += "never reached the requested period";
+    s += fmt("  longest %6llu  starvations %u  count %s%s  -> %s",
+             static_cast<unsigned long long>(r.longest), r.starvations,
+             r.count_ok ? "exact" : "WRONG",
+             (r.count_note + (r.stack_overflow ? " STACK OVERFLOW" : "")).c_str(),
+             r.clean ? "clean" : (!r.reached && r.cruise_n ? "rate not reached" : "NOT clean"));
+    return s;
+}
+
+struct RateScan {
+    double best_clean = 0; ///< highest clean rate below the first failure
+    double first_fail = 0; ///< lowest rate that was not clean (0: none)
+    std::vector<RateRun> runs;
+};
+
+RateScan scan_rates(const Config& cfg, int axes, const std::vector<double>& rates, double mm) {
+    RateScan s;
+    for (double rate : rates) {
+        RateRun r = rate_run(cfg, axes, rate, mm, false, false);
+        std::cout << "  " << describe(r) << '\n' << std::flush;
+        if (r.clean && s.first_fail == 0) s.best_clean = rate;
+        if (!r.clean && s.first_fail == 0) s.first_fail = rate;
+        s.runs.push_back(r);
+    }
+    return s;
+}
+
+/// Coarse scan (2,000, 5,000, then every 10,000 up to `to`), then 1,000 steps/s steps between
+/// the last clean and the first failing rate.
+RateScan search_rate(const Config& cfg, int axes, double to, double mm) {
+    std::vector<double> rates = {2000, 5000};
+    for (double r = 10000; r <= to + 1; r += 10000) rates.push_back(r);
+    RateScan s = scan_rates(cfg, axes, rates, mm);
+    if (s.first_fail > 0 && s.first_fail - s.best_clean > 1000 && s.best_clean > 0) {
+        std::vector<double> fine;
+        for (double r = s.best_clean + 1000; r < s.first_fail; r += 1000) fine.push_back(r);
+        RateScan f = scan_rates(cfg, axes, fine, mm);
+        s.first_fail = f.first_fail ? f.first_fail : s.first_fail;
+        if (f.best_clean) s.best_clean = f.best_clean;
+        for (RateRun& r : f.runs) s.runs.push_back(r);
+    }
+    return s;
+}
+
+// ---- where the cycles go ------------------------------------------------------------------
+
+struct FnCost {
+    std::string name;
+    size_t calls = 0;
+    uint64_t cycles = 0; ///< inclusive, without interrupts
+};
+
+using FnList = std::vector<std::pair<std::string, std::string>>; ///< symbol, display name
+
+/// Inclusive cycles (interrupts taken out) of each profiled function for calls that started at
+/// or after `from`; a function called from inside itself counts once.
+std::vector<FnCost> costs_of(const Profiler& prof, const FnList& fns, uint64_t from) {
+    std::vector<FnCost> out(fns.size());
+    for (size_t i = 0; i < fns.size(); ++i) out[i].name = fns[i].second;
+    const std::vector<Profiler::Call>& calls = prof.calls();
+    for (const Profiler::Call& c : calls) {
+        if (!c.end || c.start < from) continue;
+        bool nested = false;
+        for (int p = c.parent; p >= 0; p = calls[static_cast<size_t>(p)].parent)
+            if (calls[static_cast<size_t>(p)].fn == c.fn) nested = true;
+        if (nested) continue;
+        FnCost& f = out[static_cast<size_t>(c.fn)];
+        ++f.calls;
+        f.cycles += prof.own_cycles(c);
+    }
+    return out;
+}
+
+void print_costs(const std::vector<FnCost>& costs, const char* unit, size_t units, double window) {
+    std::cout << fmt("  %-32s %6s   %11s   %14s   %s\n", "function (inclusive)", "calls",
+                     "cycles/call", (std::string("cycles/") + unit).c_str(), "share of the time");
+    for (const FnCost& f : costs) {
+        if (!f.calls) continue;
+        std::cout << fmt("  %-32s %6zu   %11.0f   %14.0f   %5.1f %%\n", f.name.c_str(), f.calls,
+                         static_cast<double>(f.cycles) / static_cast<double>(f.calls),
+                         units ? static_cast<double>(f.cycles) / static_cast<double>(units) : 0.0,
+                         100.0 * static_cast<double>(f.cycles) / window);
+    }
+}
+
+const FnList kPlannerFns = {
+    {"_ZN2ll5gcode7executeEPKchRNS0_7OutcomeE", "gcode::execute"},
+    {"_ZN2ll3num5parseEPKcRhRNS0_7DecimalE", "num::parse"},
+    {"_ZN2ll5gcode11um_to_stepsEhlRl", "gcode::um_to_steps"},
+    {"_ZN2ll6motion9push_lineERKNS0_11LineRequestE", "motion::push_line"},
+    {"_ZN2ll7Planner3addEPKlS2_mb", "Planner::add"},
+    {"_ZN2ll11move_limitsERKNS_7MachineEPKlhRNS_10MoveLimitsE", "move_limits"},
+    {"_ZNK2ll7Planner9junction2EPKl", "Planner::junction2"},
+    {"_ZN2ll7Planner11recalculateEv", "Planner::recalculate"},
+    {"_ZN2ll3Num3mulERKS0_", "Num::mul"},
+    {"_ZN2ll3Num3divERKS0_", "Num::div"},
+    {"_ZN2ll3Num4sqrtEv", "Num::sqrt"},
+    {"_ZN2ll3Num3addERKS0_", "Num::add"},
+    {"_ZN2ll7isqrt32Em", "isqrt32"},
+    {"__udivmodsi4", "__udivmodsi4 (32-bit division)"},
+    {"_ZN2ll6motion4pollEv", "motion::poll (step generation)"},
+    {"_ZNK2ll7Planner13spec_of_firstEv", "Planner::spec_of_first"},
+    {"_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "StepGen::begin"},
+    {"_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE", "StepGen::fill"},
+    {"_ZN2ll3hal10serial_putEh", "hal::serial_put"},
+    {"_ZN2ll3app8run_onceEv", "app::run_once (the whole main loop)"},
+};
+
+// ---- circle of short segments -------------------------------------------------------------
+
+struct CircleRun {
+    size_t lines = 0;
+    size_t answered = 0; ///< lines answered (a stalled firmware answers fewer)
+    int errors = 0;      ///< lines answered with an error; -1: the job stalled
+    bool stack_overflow = false;
+    double motion_s = 0;  ///< first to last step edge
+    double worst_dev = 0; ///< ticks, Euclidean distance of a visited position to the circle
+    bool back_at_start = false;
+    uint16_t starvations = 0;
+    uint64_t steps[2] = {0, 0};
+    // Profile (character counting only)
+    bool profiled = false;
+    size_t accepted_calls = 0;      ///< gcode::execute calls that queued a move
+    Stats parse_plan;               ///< per accepted call: execute without step generation and ISRs
+    Stats planner_add;              ///< Planner::add, without ISRs
+    double parse_plan_per_line = 0; ///< every execute call (retries included) / lines
+    double producer_share = 0;      ///< motion::poll cycles (without ISRs) / motion time
+    double isr_share = 0;           ///< step interrupts / motion time
+    Stats compa;                    ///< COMPA spans during the job (run changes included)
+    std::vector<FnCost> costs;      ///< kPlannerFns
+    double window = 0;              ///< cycles from the first line sent to the last step
+};
+
+CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool profile) {
+    CircleRun c;
+    Board b(cfg.elf);
+    b.settings({"$100=80", "$101=80", "$110=5000", "$111=5000", "$120=1000", "$121=1000"});
+    const std::vector<std::string> job = circle_job(radius, 0.1, 3000);
+    c.lines = job.size();
+    std::unique_ptr<Profiler> prof;
+    const std::string kExecute = "_ZN2ll5gcode7executeEPKchRNS0_7OutcomeE";
+    const std::string kAdd = "_ZN2ll7Planner3addEPKlS2_mb";
+    if (profile) {
+        std::vector<std::string> syms;
+        for (const auto& f : kPlannerFns) syms.push_back(f.first);
+        prof.reset(new Profiler(b.sim, syms));
+        b.host.hook = [&] { prof->step(); };
+    }
+    const uint64_t job_start = b.sim.cycle();
+    c.errors = b.host.stream(job, send_and_wait, ms(2000));
+    c.answered = b.host.answered();
+    // Wait until the motion is over: nothing running and no edge for 50 ms.
+    size_t last_edges = b.sim.edges().size();
+    uint64_t quiet_since = b.sim.cycle();
+    const uint64_t timeout = b.sim.cycle() + ms(10000);
+    while (b.sim.cycle() < timeout) {
+        b.host.run_for(ms(5));
+        if (b.sim.edges().size() != last_edges) {
+            last_edges = b.sim.edges().size();
+            quiet_since = b.sim.cycle();
+        } else if (b.sim.cycle() - quiet_since >= ms(50) && !b.running()) {
+            break;
+        }
+    }
+    c.starvations = b.starvations();
+    c.stack_overflow = b.stack->overflowed();
+    const Trace t = trace_steps(b.sim);
+    c.motion_s = (t.last() - t.first()) / kCpu;
+    c.steps[0] = t.steps(0);
+    c.steps[1] = t.steps(1);
+    c.back_at_start = t.final_pos[0] == 0 && t.final_pos[1] == 0;
+    const double r = radius * 80, cx = -r;
+    for (const auto& p : t.pos)
+        c.worst_dev = std::max(c.worst_dev, std::fabs(std::hypot(p[0] - cx, p[1]) - r));
+    if (prof) {
+        c.profiled = true;
+        // Step generation: motion::poll and what it runs, also where push_line inlines it.
+        std::vector<bool> is_gen(kPlannerFns.size(), false);
+        for (const char* g :
+             {"_ZN2ll6motion4pollEv", "_ZNK2ll7Planner13spec_of_firstEv",
+              "_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE"}) {
+            const int k = prof->index_of(g);
+            if (k >= 0) is_gen[static_cast<size_t>(k)] = true;
+        }
+        const int fe = prof->index_of(kExecute), fa = prof->index_of(kAdd);
+        const std::vector<Profiler::Call>& calls = prof->calls();
+        std::vector<uint64_t> exec_own(calls.size(), 0);
+        std::vector<bool> queued(calls.size(), false);
+        std::vector<uint64_t> per_call, adds;
+        uint64_t poll_total = 0, all_exec = 0;
+        for (size_t i = 0; i < calls.size(); ++i) {
+            const Profiler::Call& k = calls[i];
+            if (!k.end || k.start < job_start) continue;
+            const uint64_t own = prof->own_cycles(k);
+            if (k.fn == fe) exec_own[i] += own;
+            // The innermost enclosing execute, and whether step generation encloses this call.
+            int p = -1;
+            bool inside_gen = false;
+            for (int q = k.parent; q >= 0; q = calls[static_cast<size_t>(q)].parent) {
+                if (is_gen[static_cast<size_t>(calls[static_cast<size_t>(q)].fn)])
+                    inside_gen = true;
+                if (p < 0 && calls[static_cast<size_t>(q)].fn == fe) p = q;
+            }
+            if (is_gen[static_cast<size_t>(k.fn)] && !inside_gen) {
+                poll_total += own;
+                if (p >= 0) exec_own[static_cast<size_t>(p)] -= own;
+            }
+            if (k.fn == fa) {
+                adds.push_back(own);
+                if (p >= 0) queued[static_cast<size_t>(p)] = true;
+            }
+        }
+        for (size_t i = 0; i < calls.size(); ++i) {
+            if (calls[i].fn != fe || !calls[i].end || calls[i].start < job_start) continue;
+            all_exec += exec_own[i];
+            if (queued[i]) per_call.push_back(exec_own[i]);
+        }
+        c.accepted_calls = per_call.size();
+        c.parse_plan = stats_of(per_call);
+        c.planner_add = stats_of(adds);
+        c.parse_plan_per_line = static_cast<double>(all_exec) / static_cast<double>(c.lines);
+        const double motion_cycles = static_cast<double>(t.last() - t.first());
+        c.producer_share = static_cast<double>(poll_total) / motion_cycles;
+        uint64_t isr = 0;
+        std::vector<uint64_t> a_spans;
+        for (const IsrSpan& sp : b.sim.isr_spans()) {
+            if (sp.accepted < t.first() || !sp.returned || sp.returned > t.last()) continue;
+            if (sp.vector == 11 || sp.vector == 12) isr += sp.returned - sp.accepted;
+            if (sp.vector == 11) a_spans.push_back(sp.returned - sp.accepted);
+        }
+        c.isr_share = static_cast<double>(isr) / motion_cycles;
+        c.compa = stats_of(a_spans);
+        c.costs = costs_of(*prof, kPlannerFns, job_start);
+        c.window = static_cast<double>(std::max(t.last(), b.sim.cycle()) - job_start);
+    }
+    return c;
+}
+
+void print_circle(const char* label, const CircleRun& c, double ideal) {
+    const bool stalled = c.errors < 0;
+    if (stalled)
+        std::cout << fmt("  %-20s STALLED: %zu of %zu lines answered (then no answer for 2 s); "
+                         "what it did until then:\n",
+                         label, c.answered, c.lines);
+    if (c.stack_overflow)
+        std::cout << "  (the stack reached the end of .bss during this run: figures unreliable)\n";
+    std::cout << fmt(
+        "  %-20s %zu lines, %d errors, motion %.4f s (%.3fx ideal %.4f s), worst "
+        "deviation %.3f ticks, steps X %llu Y %llu, %s, starvations %u\n",
+        stalled ? "" : label, c.lines, stalled ? 0 : c.errors, c.motion_s, c.motion_s / ideal,
+        ideal, c.worst_dev, static_cast<unsigned long long>(c.steps[0]),
+        static_cast<unsigned long long>(c.steps[1]),
+        c.back_at_start ? "back at the start" : "NOT back at the start", c.starvations);
+    if (c.profiled) {
+        std::cout << fmt("  parse + plan per G1 line (gcode::execute, without step generation and "
+                         "interrupts): median %llu, min %llu, max %llu cycles over %zu lines; "
+                         "%.0f per line sent, retries included\n",
+                         static_cast<unsigned long long>(c.parse_plan.median),
+                         static_cast<unsigned long long>(c.parse_plan.min),
+                         static_cast<unsigned long long>(c.parse_plan.max), c.accepted_calls,
+                         c.parse_plan_per_line);
+        std::cout << fmt("  CPU during the motion: step generation (motion::poll) %.1f %%, step "
+                         "interrupt %.1f %% (COMPA %llu/%llu/%llu cycles)\n",
+                         100 * c.producer_share, 100 * c.isr_share,
+                         static_cast<unsigned long long>(c.compa.min),
+                         static_cast<unsigned long long>(c.compa.median),
+                         static_cast<unsigned long long>(c.compa.max));
+        std::cout
+            << "  where the main loop's cycles go (from the first line sent to the last step):\n";
+        print_costs(c.costs, "line", c.accepted_calls, c.window);
+    }
+}
+
+// ---- the interrupt alone (bench image) -----------------------------------------------------
+
+struct CeilingRun {
+    uint64_t steps = 0, expected = 0;
+    Stats intervals;
+};
+
+/// The bench image feeds runs of `period` cycles straight to the step interrupt (no planner):
+/// the rate the interrupt itself sustains.
+CeilingRun ceiling_run(const Config& cfg, uint8_t mask, unsigned copies, unsigned period) {
+    CeilingRun c;
+    Sim sim(cfg.bench_elf);
+    if (!sim.run_until_output("['R s d c p' to step]", ms(100)))
+        fail("no banner from " + cfg.bench_elf);
+    Host h(sim);
+    for (const std::string& l : {std::string("C 48 0 0 0"), std::string("E 1"),
+                                 fmt("F %u %u 0 255 %u", copies, mask, period)}) {
+        sim.send(l + "\n");
+        if (!sim.run_until_output("ok", ms(5000))) fail("bench image: no ok for " + l);
+    }
+    sim.run_for(static_cast<uint64_t>(copies) * 255 * period + ms(5));
+    const Trace t = trace_steps(sim);
+    c.steps = t.steps(0);
+    c.expected = static_cast<uint64_t>(copies) * 255;
+    std::vector<uint64_t> d;
+    for (int a = 0; a < 3; ++a) {
+        if (!(mask & (1u << a))) continue;
+        const std::vector<uint64_t>& e = t.edges[static_cast<size_t>(a)];
+        for (size_t i = 1; i < e.size(); ++i) d.push_back(e[i] - e[i - 1]);
+    }
+    c.intervals = stats_of(d);
+    return c;
+}
+
+// ---- where the producer's cycles go ---------------------------------------------------------
+
+/// Profiles one move of `mm` on X at `rate` steps/s: cycles of the step generator per segment
+/// (one line_advance() call per segment) and the functions it spends them in.
+std::vector<FnCost> producer_profile(const Config& cfg, double rate, double mm, size_t* segments,
+                                     double* motion_cycles) {
+    const FnList fns = {
+        {"_ZN2ll6motion4pollEv", "motion::poll"},
+        {"_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE", "StepGen::fill"},
+        {"_ZN2ll12line_advanceERKNS_12LineGeometryERNS_10LineCursorEhPh", "line_advance"},
+        {"_ZN2ll11micro_splitEPKhhPNS_8MicroRunE", "micro_split"},
+        {"_ZN2ll9profile_aERKNS_7ProfileEm", "profile_a"},
+        {"_ZN2ll11SqrtTracker4seekEm", "SqrtTracker::seek"},
+        {"_ZN2ll7StepGen4emitERNS_7RunRingILh32EEEhhm", "StepGen::emit"},
+        {"_ZN2ll7StepGen13queued_cyclesERKNS_7RunRingILh32EEE", "StepGen::queued_cycles"},
+        {"_ZN2ll7mul_shrEmmh", "mul_shr"},
+        {"__udivmodsi4", "__udivmodsi4 (32-bit division)"},
+        {"__mulsi3", "__mulsi3"},
+        {"_ZN2ll7StepGen8set_exitEm", "StepGen::set_exit"},
+        {"_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "StepGen::begin"},
+    };
+    Board b(cfg.elf);
+    b.settings({"$0=3", "$100=1000", "$110=300000", "$120=2000", "G91"});
+    std::vector<std::string> syms;
+    for (const auto& f : fns) syms.push_back(f.first);
+    Profiler prof(b.sim, syms);
+    b.host.hook = [&] { prof.step(); };
+    const uint64_t t0 = b.sim.cycle();
+    if (b.host.send_line("G1X" + fmt("%.3f", mm) + feed_word(rate * 0.06), ms(1000)) != 0)
+        fail("producer: move refused");
+    const uint64_t expected = static_cast<uint64_t>(std::llround(mm * 1000));
+    const uint64_t timeout = b.sim.cycle() + ms(10000);
+    while (b.sim.cycle() < timeout && trace_steps(b.sim).steps(0) < expected)
+        b.host.run_for(ms(20));
+    b.host.run_for(ms(10));
+    const Trace t = trace_steps(b.sim);
+    *motion_cycles = static_cast<double>(t.last() - t.first());
+    std::vector<FnCost> out = costs_of(prof, fns, t0);
+    *segments = out[2].calls;
+    return out;
+}
+
+// ---- report ---------------------------------------------------------------------------------
+
+struct Row {
+    std::string figure, ours, goal, grbl, met;
+};
+
+void usage() {
+    std::cout << "usage: llbench [--quick] [--only rate|isr|circle|size|ceiling]... [--elf FILE]\n"
+                 "               [--bench-elf FILE] [-v]\n"
+                 "Measures Low Level on simavr (exact cycles) and prints docs/benchmarks.md's "
+                 "figures.\n";
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    Config cfg;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc) fail(a + " needs a value");
+            return argv[++i];
+        };
+        if (a == "--quick")
+            cfg.quick = true;
+        else if (a == "--only")
+            cfg.only.insert(value());
+        else if (a == "--elf")
+            cfg.elf = value();
+        else if (a == "--bench-elf")
+            cfg.bench_elf = value();
+        else if (a == "-v" || a == "--verbose")
+            cfg.verbose = true;
+        else if (a == "-h" || a == "--help") {
+            usage();
+            return 0;
+        } else {
+            usage();
+            return 2;
+        }
+    }
+    const auto wall0 = std::chrono::steady_clock::now();
+    std::vector<Row> rows;
+    const std::string grbl_note = "";
+
+    std::cout << "llbench: " << cfg.elf << (cfg.quick ? " (quick configuration)" : "") << "\n";
+
+    if (cfg.want("rate")) {
+        const double mm = cfg.quick ? 3 : 30;
+        std::cout << "\n## Maximum clean step rate, 1 axis (G1 X" << mm
+                  << ", 1000 steps/mm, 2000 mm/s², $0=3)\n";
+        RateScan one =
+            cfg.quick ? scan_rates(cfg, 1, {30000}, mm) : search_rate(cfg, 1, 110000, mm);
+        std::cout << "\n## Maximum clean step rate, XYZ diagonal (per axis)\n";
+        RateScan three =
+            cfg.quick ? scan_rates(cfg, 3, {20000}, mm) : search_rate(cfg, 3, 110000, mm);
+        auto verdict = [](const RateScan& s) {
+            if (s.best_clean == 0 && !s.runs.empty())
+                return "none clean from " + thousands(s.runs.front().requested) + " steps/s";
+            std::string v = thousands(s.best_clean) + " steps/s";
+            if (s.first_fail) v += " (not clean at " + thousands(s.first_fail) + ")";
+            return v;
+        };
+        rows.push_back({"Max clean step rate, 1 axis", verdict(one), "≥ 100,000 steps/s",
+                        "30,000 clean; gaps at 40,000", one.best_clean >= 100000 ? "yes" : "no"});
+        rows.push_back({"Max clean step rate, XYZ diagonal, per axis", verdict(three),
+                        "≥ 60,000 steps/s", "half the rate on 3 axes",
+                        three.best_clean >= 60000 ? "yes" : "no"});
+    }
+
+    if (cfg.want("ceiling")) {
+        std::cout << "\n## The step interrupt alone (lowlevel_bench.elf, runs fed directly, period "
+                     "152 = 105,263 steps/s)\n";
+        for (uint8_t mask : {uint8_t(1), uint8_t(7)}) {
+            const CeilingRun c = ceiling_run(cfg, mask, cfg.quick ? 4 : 200, 152);
+            std::cout << fmt("  %s: %llu of %llu steps, intervals %llu/%llu/%llu cycles "
+                             "(min/median/max)\n",
+                             mask == 1 ? "X      " : "X+Y+Z  ",
+                             static_cast<unsigned long long>(c.steps),
+                             static_cast<unsigned long long>(c.expected),
+                             static_cast<unsigned long long>(c.intervals.min),
+                             static_cast<unsigned long long>(c.intervals.median),
+                             static_cast<unsigned long long>(c.intervals.max));
+        }
+    }
+
+    if (cfg.want("isr")) {
+        const double mm = cfg.quick ? 2 : 20;
+        std::cout << "\n## Step interrupt at 30,000 steps/s, 1 axis (G1 X" << mm << ")\n";
+        const RateRun quiet = rate_run(cfg, 1, 30000, mm, false, true);
+        std::cout << "  no serial traffic:   " << describe(quiet) << '\n';
+        const RateRun polled = rate_run(cfg, 1, 30000, mm, true, true);
+        std::cout << "  '?' every 50 ms:     " << describe(polled) << '\n';
+        std::cout << fmt("  COMPA %llu/%llu/%llu, COMPB %llu/%llu/%llu, per step %llu/%llu/%llu "
+                         "cycles (min/median/max, from acceptance to the end of RETI)\n",
+                         static_cast<unsigned long long>(polled.compa.min),
+                         static_cast<unsigned long long>(polled.compa.median),
+                         static_cast<unsigned long long>(polled.compa.max),
+                         static_cast<unsigned long long>(polled.compb.min),
+                         static_cast<unsigned long long>(polled.compb.median),
+                         static_cast<unsigned long long>(polled.compb.max),
+                         static_cast<unsigned long long>(polled.per_step.min),
+                         static_cast<unsigned long long>(polled.per_step.median),
+                         static_cast<unsigned long long>(polled.per_step.max));
+        std::cout << fmt("  step interrupt share of the CPU at cruise: %.2f %%\n",
+                         100 * polled.isr_share);
+        rows.push_back(
+            {"Step interrupt, cycles per step (min / median / max)",
+             fmt("%llu / %llu / %llu", static_cast<unsigned long long>(polled.per_step.min),
+                 static_cast<unsigned long long>(polled.per_step.median),
+                 static_cast<unsigned long long>(polled.per_step.max)),
+             "—", "not remeasured", "—"});
+        rows.push_back({"Step interrupt CPU share at 30 kHz",
+                        fmt("%.1f %%", 100 * polled.isr_share), "—", "not remeasured", "—"});
+        std::string jit = fmt("%+lld / %+lld cycles", static_cast<long long>(polled.jitter_lo),
+                              static_cast<long long>(polled.jitter_hi));
+        if (polled.gaps)
+            jit += fmt(" between %zu gaps (longest %s cycles)", polled.gaps,
+                       thousands(static_cast<double>(polled.worst)).c_str());
+        rows.push_back(
+            {"Cruise interval jitter at 30 kHz, '?' every 50 ms", jit, "better than GRBL",
+             "±12 cycles",
+             !polled.gaps && std::max(-polled.jitter_lo, polled.jitter_hi) < 12 ? "yes" : "no"});
+    }
+
+    if (cfg.want("producer")) {
+        const double rate = 30000, mm = cfg.quick ? 2 : 10;
+        size_t segments = 0;
+        double motion = 0;
+        const std::vector<FnCost> costs = producer_profile(cfg, rate, mm, &segments, &motion);
+        std::cout << fmt("\n## Step generation (the producer) during G1 X%g at %s steps/s: "
+                         "%zu segments\n",
+                         mm, thousands(rate).c_str(), segments);
+        print_costs(costs, "segment", segments, motion);
+        const double per_segment =
+            segments ? static_cast<double>(costs[1].cycles) / static_cast<double>(segments) : 0;
+        rows.push_back({"Step generation per macro segment (StepGen::fill)",
+                        thousands(per_segment) + " cycles", "< 2,048 (kSegmentCycles)", "—",
+                        per_segment < 2048 ? "yes" : "no"});
+    }
+
+    if (cfg.want("circle")) {
+        const double radius = cfg.quick ? 1 : 10, v = 50.0, acc = 1000.0;
+        const double ideal = 2 * kPi * radius / v + v / acc;
+        std::cout << fmt("\n## Circle r = %g mm of 0.1 mm G1 segments, F3000, 80 steps/mm, "
+                         "1000 mm/s², 115200 baud\n",
+                         radius);
+        const CircleRun cc = circle_run(cfg, radius, false, true);
+        print_circle("character counting:", cc, ideal);
+        auto circle_figure = [&](const CircleRun& c) {
+            if (c.errors < 0) return fmt("stalled after %zu of %zu lines", c.answered, c.lines);
+            std::string f = fmt("%.3f s (%.3fx ideal)", c.motion_s, c.motion_s / ideal);
+            if (c.errors) f += fmt(", %d errors", c.errors);
+            if (!c.back_at_start) f += ", wrong end position";
+            return f;
+        };
+        auto circle_met = [&](const CircleRun& c) {
+            return c.errors == 0 && c.back_at_start && c.motion_s <= 1.1 * ideal ? "yes" : "no";
+        };
+        rows.push_back({"Circle r10, 0.1 mm segments, character counting", circle_figure(cc),
+                        "≤ 1.44 s (1.1x ideal 1.3066 s)", "1.91 s", circle_met(cc)});
+        rows.push_back({"Circle: worst deviation from the true circle",
+                        cc.errors < 0 ? "—" : fmt("%.2f ticks", cc.worst_dev), "—",
+                        "not remeasured", "—"});
+        rows.push_back(
+            {"Parse + plan one 0.1 mm G1 line (median / max)",
+             fmt("%s / %s cycles", thousands(static_cast<double>(cc.parse_plan.median)).c_str(),
+                 thousands(static_cast<double>(cc.parse_plan.max)).c_str()),
+             "≤ 16,000 cycles", "not remeasured", cc.parse_plan.median <= 16000 ? "yes" : "no"});
+        rows.push_back({"Short G1 lines planned per second of CPU",
+                        thousands(kCpu / static_cast<double>(cc.parse_plan.median)), "≥ 1,000",
+                        "not remeasured",
+                        kCpu / static_cast<double>(cc.parse_plan.median) >= 1000 ? "yes" : "no"});
+        if (!cfg.quick) {
+            const CircleRun cs = circle_run(cfg, radius, true, false);
+            print_circle("send-and-wait:", cs, ideal);
+            rows.push_back({"Circle, send-and-wait", circle_figure(cs), "—", "2.38 s", "—"});
+        }
+    }
+
+    if (cfg.want("size")) {
+        const ImageSize s = image_size(cfg.elf);
+        if (g_boards == 0) {
+            // No run yet: one short job for the stack watermark.
+            Board b(cfg.elf);
+            b.settings({"$100=80", "$101=80", "$120=1000", "$121=1000"});
+            b.host.stream(circle_job(1, 0.1, 3000), false, ms(2000));
+            b.host.run_for(ms(300));
+        }
+        const unsigned total = s.ram + g_stack_peak;
+        std::cout << fmt("\n## Image size\n  flash %s B of 32,768 (%s B usable with the Uno "
+                         "bootloader), static RAM %s B of 2,048; deepest stack seen in these runs "
+                         "%u B (static + stack = %s B)%s\n",
+                         thousands(s.flash).c_str(), thousands(32256).c_str(),
+                         thousands(s.ram).c_str(), g_stack_peak, thousands(total).c_str(),
+                         g_stack_overflows
+                             ? fmt("; the stack reached the end of .bss in %d of %d runs",
+                                   g_stack_overflows, g_boards)
+                                   .c_str()
+                             : "");
+        rows.push_back({"Flash (lowlevel.elf)", thousands(s.flash) + " B",
+                        "≤ 32,256 B (Uno with bootloader)", "29,864 B",
+                        s.flash <= 32256 ? "yes" : "no"});
+        rows.push_back({"Static RAM (.data + .bss)", thousands(s.ram) + " B", "—", "1,633 B", "—"});
+        rows.push_back({"Static RAM + deepest stack",
+                        g_stack_overflows ? fmt("≥ %s B: stack overflow", thousands(2048).c_str())
+                                          : thousands(total) + " B",
+                        "≤ 2,048 B", "not remeasured",
+                        !g_stack_overflows && total <= 2048 ? "yes" : "no"});
+    }
+
+    std::cout << "\n## Summary (GRBL 1.1h column: figures from the issue, not remeasured)\n\n";
+    std::cout << "| Figure | Low Level | Goal | GRBL 1.1h | Goal met |\n|---|---|---|---|---|\n";
+    for (const Row& r : rows)
+        std::cout << "| " << r.figure << " | " << r.ours << " | " << r.goal << " | " << r.grbl
+                  << " | " << r.met << " |\n";
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    std::cerr << fmt("llbench: %.1f s of wall time\n", wall);
+    return 0;
+}
