@@ -88,8 +88,8 @@ void CurveWalker::start_piece(const int32_t p0[3], const int32_t p1[3], const in
 }
 
 void CurveWalker::arc_point(int32_t c, int32_t s, int32_t out[2]) const {
-    out[0] = centre_[0] + scale_q30(static_cast<int32_t>(radii_[0]), c);
-    out[1] = centre_[1] + scale_q30(static_cast<int32_t>(radii_[1]), s);
+    out[0] = a_.centre[0] + scale_q30(static_cast<int32_t>(a_.radii[0]), c);
+    out[1] = a_.centre[1] + scale_q30(static_cast<int32_t>(a_.radii[1]), s);
 }
 
 bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t radii_q8[2],
@@ -99,20 +99,22 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     kind_ = 0;
     if (radii_q8[0] == 0 || radii_q8[1] == 0) return false;
     for (uint8_t a = 0; a < 2; ++a) {
-        centre_[a] = centre_q8[a];
-        radii_[a] = radii_q8[a];
+        a_.centre[a] = centre_q8[a];
+        a_.radii[a] = radii_q8[a];
     }
     for (uint8_t a = 0; a < 3; ++a) {
         pos[a] = start[a];
         end_[a] = end[a];
     }
     // Directions of the start and end points (their projections on the curve), and the sweep.
-    ellipse_direction(e.start_q8[0] - centre_[0], e.start_q8[1] - centre_[1], radii_, c_, s_);
-    ellipse_direction(e.end_q8[0] - centre_[0], e.end_q8[1] - centre_[1], radii_, end_c_, end_s_);
-    int64_t sweep = arc_sweep_q29(c_, s_, end_c_, end_s_, clockwise, turns);
+    ellipse_direction(e.start_q8[0] - a_.centre[0], e.start_q8[1] - a_.centre[1], a_.radii, a_.c,
+                      a_.s);
+    ellipse_direction(e.end_q8[0] - a_.centre[0], e.end_q8[1] - a_.centre[1], a_.radii, end_c_,
+                      end_s_);
+    int64_t sweep = arc_sweep_q29(a_.c, a_.s, end_c_, end_s_, clockwise, turns);
     // Pieces: at most 22.5 degrees and kMaxPieceTicks long.
     uint64_t mag = static_cast<uint64_t>(sweep < 0 ? -sweep : sweep);
-    uint32_t rmax = (radii_[0] > radii_[1] ? radii_[0] : radii_[1]) >> 8;
+    uint32_t rmax = (a_.radii[0] > a_.radii[1] ? a_.radii[0] : a_.radii[1]) >> 8;
     // The sweep is below 2^40 (255 turns), so these quotients are of small numbers.
     uint32_t by_angle = static_cast<uint32_t>(mag >> 26) / (kMaxPieceAngleQ29 >> 26) + 1;
     // length = sweep x radius = (mag / 2^29) rmax ticks, over kMaxPieceTicks
@@ -124,12 +126,12 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     // Piece angle, Q30 (at most 22.5 degrees, so the series apply).
     int32_t h = static_cast<int32_t>(Num(static_cast<uint32_t>(mag >> 10)).div(n).shift(11).u32());
     if (sweep < 0) h = -h;
-    small_angle_q30(h, rot_c_, rot_s_, arm_);
+    small_angle_q30(h, a_.rot_c, a_.rot_s, a_.arm);
     // Helix axis: linear along the curve.
     w0_q8_ = start[2] * 256;
     dw_q8_ = (end[2] - start[2]) * 256;
     int32_t p[2];
-    arc_point(c_, s_, p);
+    arc_point(a_.c, a_.s, p);
     prev_q8_[0] = p[0];
     prev_q8_[1] = p[1];
     prev_q8_[2] = w0_q8_;
@@ -214,8 +216,8 @@ bool CurveWalker::next_piece() {
     p1[2] = p0[2] + (w3 - p0[2]) / 3;
     p2[2] = w3 - (w3 - p0[2]) / 3;
     if (kind_ == 1) {
-        int32_t c = mul_q30(c_, rot_c_) - mul_q30(s_, rot_s_);
-        int32_t s = mul_q30(s_, rot_c_) + mul_q30(c_, rot_s_);
+        int32_t c = mul_q30(a_.c, a_.rot_c) - mul_q30(a_.s, a_.rot_s);
+        int32_t s = mul_q30(a_.s, a_.rot_c) + mul_q30(a_.c, a_.rot_s);
         if (last) { // land on the end point's direction: no drift left over
             c = end_c_;
             s = end_s_;
@@ -225,13 +227,13 @@ bool CurveWalker::next_piece() {
         p3[0] = q[0];
         p3[1] = q[1];
         // Arms along the tangents (dX/dt = -ru sin t, dY/dt = rv cos t), 4/3 tan(h/4) long.
-        int32_t arm = arm_;
-        p1[0] = p0[0] + scale_q30(scale_q30(static_cast<int32_t>(radii_[0]), -s_), arm);
-        p1[1] = p0[1] + scale_q30(scale_q30(static_cast<int32_t>(radii_[1]), c_), arm);
-        p2[0] = p3[0] - scale_q30(scale_q30(static_cast<int32_t>(radii_[0]), -s), arm);
-        p2[1] = p3[1] - scale_q30(scale_q30(static_cast<int32_t>(radii_[1]), c), arm);
-        c_ = c;
-        s_ = s;
+        int32_t arm = a_.arm;
+        p1[0] = p0[0] + scale_q30(scale_q30(static_cast<int32_t>(a_.radii[0]), -a_.s), arm);
+        p1[1] = p0[1] + scale_q30(scale_q30(static_cast<int32_t>(a_.radii[1]), a_.c), arm);
+        p2[0] = p3[0] - scale_q30(scale_q30(static_cast<int32_t>(a_.radii[0]), -s), arm);
+        p2[1] = p3[1] - scale_q30(scale_q30(static_cast<int32_t>(a_.radii[1]), c), arm);
+        a_.c = c;
+        a_.s = s;
     } else {
         // Bezier part [a, a + 1/n]: ends and tangents of the curve, arms = slope / (3 n).
         uint32_t a0 = static_cast<uint32_t>(index) << (20 - log_pieces_);

@@ -334,6 +334,7 @@ void set_end_modes(Modal& m) {
 uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     State& st = g_state;
     outcome.then = Then::Nothing;
+    outcome.move = nullptr;
     outcome.dwell_ms = 0;
 
     // ---- Stage 1: a block that starts from the current modes.
@@ -511,7 +512,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     if (moves) {
         req.feed = b.feed;
         req.rapid = motion == Motion::Seek;
-        if (!check) motion::push_line(req); // cannot refuse: the length was checked above
+        if (!check) outcome.move = &req; // queued by the caller; the length was checked above
         copy_words(st.position, req.target_um, kAxes);
         copy_words(st.position_steps, req.target_steps, kAxes);
     }

@@ -242,6 +242,7 @@ void run_gcode() {
     gcode::Outcome o;
     uint8_t r = gcode::execute(
         p.line, static_cast<uint8_t>(p.gflags | (p.check ? gcode::kCheckMode : 0)), o);
+    if (o.move) motion::push_line(*o.move); // planned here, not under execute()'s frame
     if (r >= gcode::kRetryWhenAccepting) {
         p.dwell = o.dwell_ms;
         p.wait = static_cast<Wait>(r - gcode::kRetryWhenAccepting + uint8_t(Wait::WhenAccepting));

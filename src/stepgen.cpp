@@ -36,8 +36,8 @@ bool StepGen::begin(const MoveSpec& spec) {
     pushed_position(start_); // the previous move is complete: start from its end
     curve_ = nullptr;
     if (spec.curve) return begin_curve(spec);
-    if (!line_setup(line_, spec.delta)) {
-        line_.m = 0;
+    if (!line_setup(ln_.g, spec.delta)) {
+        ln_.g.m = 0;
         return false;
     }
     len_q8_ = spec.len_q8;
@@ -45,12 +45,12 @@ bool StepGen::begin(const MoveSpec& spec) {
     feed_ = spec.feed;
     v_nominal2_ = spec.v_nominal2;
     v_exit2_ = spec.v_exit2;
-    line_start(line_, cursor_);
+    line_start(ln_.g, ln_.c);
     build_k_table(spec.group);
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
-    prepare_profile(entry, spec.v_exit2, line_.dist[0]);
+    prepare_profile(entry, spec.v_exit2, ln_.g.dist[0]);
     if (holding_) {
         a_hold_ = prof_.a_entry;
         x2_hold_ = 0;
@@ -62,14 +62,14 @@ bool StepGen::begin(const MoveSpec& spec) {
 }
 
 void StepGen::build_k_table(uint8_t group) {
-    const uint8_t m = line_.m;
+    const uint8_t m = ln_.g.m;
     const uint8_t sets = static_cast<uint8_t>(1u << (m - 1));
     for (uint8_t sub = 0; sub < sets; ++sub) {
-        uint8_t mask = static_cast<uint8_t>(1u << line_.axis[0]);
+        uint8_t mask = static_cast<uint8_t>(1u << ln_.g.axis[0]);
         for (uint8_t j = 1; j < m; ++j) {
-            if (sub & (1u << (j - 1))) mask = static_cast<uint8_t>(mask | (1u << line_.axis[j]));
+            if (sub & (1u << (j - 1))) mask = static_cast<uint8_t>(mask | (1u << ln_.g.axis[j]));
         }
-        k_mask_[sub] = mask;
+        ln_.mask[sub] = mask;
     }
     // Feed along the line (docs/motion.md): a line of d_1 micro steps takes len / V, so the
     // micro steps share that time in proportion to their regulated lengths L_P. Over the runs
@@ -80,12 +80,12 @@ void StepGen::build_k_table(uint8_t group) {
     //   K[P] = L_P * count_g / sum_g  (Q20), and 1 for a run without a regulated axis.
     uint32_t lens[1u << (kAxes - 1)];
     for (uint8_t sub = 0; sub < sets; ++sub) {
-        lens[sub] = step_length(*lengths_, static_cast<uint8_t>(k_mask_[sub] & group));
+        lens[sub] = step_length(*lengths_, static_cast<uint8_t>(ln_.mask[sub] & group));
     }
     Num sum_g{};
     uint32_t count_g = 0;
     for (uint8_t i = 0; i < m; ++i) {
-        uint32_t n = line_.dist[i] - (i + 1 < m ? line_.dist[i + 1] : 0);
+        uint32_t n = ln_.g.dist[i] - (i + 1 < m ? ln_.g.dist[i + 1] : 0);
         uint32_t len = lens[(1u << i) - 1];
         if (len != 0) {
             sum_g.add(Num(n).mul(len));
@@ -99,10 +99,10 @@ void StepGen::build_k_table(uint8_t group) {
     }
     Num r(count_g, 20);
     r.div(sum_g);
-    kmax_ = 0;
+    ln_.kmax = 0;
     for (uint8_t sub = 0; sub < sets; ++sub) {
-        k_[sub] = lens[sub] != 0 ? r.of(lens[sub]) : 1ul << 20;
-        if (k_[sub] > kmax_) kmax_ = k_[sub];
+        ln_.k[sub] = lens[sub] != 0 ? r.of(lens[sub]) : 1ul << 20;
+        if (ln_.k[sub] > ln_.kmax) ln_.kmax = ln_.k[sub];
     }
 }
 
@@ -114,21 +114,21 @@ uint32_t StepGen::a_of(uint32_t v2) const {
 bool StepGen::begin_curve(const MoveSpec& spec) {
     const CurveParams& c = *spec.curve;
     if (!um_q8_per_step_) return false;
-    line_.m = 0;
-    plane_axes(c.plane, curve_axes_);
+    ln_.g.m = 0;
+    plane_axes(c.plane, cv_.axes);
     // Machine positions (ticks) and commanded points of the plane (ticks x 256) for the walker:
     // µm x steps per µm, i.e. x 256 / (µm x 256 per step).
     CurveWalker::Ends e;
     int32_t centre[2], other[2];
     uint32_t radii[2];
     for (uint8_t k = 0; k < 3; ++k) {
-        uint8_t a = curve_axes_[k];
+        uint8_t a = cv_.axes[k];
         e.start[k] = start_[a];
         e.end[k] = start_[a] + spec.delta[a];
     }
     for (uint8_t k = 0; k < 2; ++k) {
         Num per_um(65536);
-        per_um.div(um_q8_per_step_[curve_axes_[k]]); // ticks x 256 per µm
+        per_um.div(um_q8_per_step_[cv_.axes[k]]); // ticks x 256 per µm
         auto to_q8 = [&](int32_t um) {
             int32_t v = static_cast<int32_t>(per_um.of(abs32(um)));
             return um < 0 ? -v : v;
@@ -139,8 +139,8 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
         other[k] = to_q8(c.b_um[k]);
         radii[k] = static_cast<uint32_t>(abs32(other[k]));
     }
-    bool ok = c.kind == kCurveArc ? walker_.arc(e, centre, radii, c.clockwise != 0, c.turns)
-                                  : walker_.bezier(e, centre, other);
+    bool ok = c.kind == kCurveArc ? cv_.w.arc(e, centre, radii, c.clockwise != 0, c.turns)
+                                  : cv_.w.bezier(e, centre, other);
     if (!ok) return false;
     curve_ = &c;
     len_q8_ = spec.len_q8;
@@ -149,13 +149,13 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     v_nominal2_ = spec.v_nominal2;
     v_exit2_ = spec.v_exit2;
     // The profile's reference axis is a virtual one with 1000 ticks per mm (µm) along the path.
-    ref_um_ = len_q8_ >> 8;
-    if (ref_um_ == 0) ref_um_ = 1;
-    x_q8_ = 0;
+    cv_.ref_um = len_q8_ >> 8;
+    if (cv_.ref_um == 0) cv_.ref_um = 1;
+    cv_.x_q8 = 0;
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
-    prepare_profile(entry, spec.v_exit2, ref_um_);
+    prepare_profile(entry, spec.v_exit2, cv_.ref_um);
     if (holding_) {
         a_hold_ = prof_.a_entry;
         x2_hold_ = 0;
@@ -233,19 +233,19 @@ uint32_t StepGen::speed2() const {
 void StepGen::pushed_position(int32_t out[kAxes]) const {
     for (uint8_t a = 0; a < kAxes; ++a) out[a] = start_[a];
     if (curve_) {
-        for (uint8_t k = 0; k < 3; ++k) out[curve_axes_[k]] = walker_.pos[k];
+        for (uint8_t k = 0; k < 3; ++k) out[cv_.axes[k]] = cv_.w.pos[k];
         return;
     }
-    for (uint8_t j = 0; j < line_.m; ++j) {
-        uint8_t a = line_.axis[j];
-        int32_t p = static_cast<int32_t>(cursor_.pos[j]);
-        out[a] += (line_.dirs & (1u << a)) ? -p : p;
+    for (uint8_t j = 0; j < ln_.g.m; ++j) {
+        uint8_t a = ln_.g.axis[j];
+        int32_t p = static_cast<int32_t>(ln_.c.pos[j]);
+        out[a] += (ln_.g.dirs & (1u << a)) ? -p : p;
     }
 }
 
 void StepGen::set_position(const int32_t steps[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) start_[a] = steps[a];
-    line_.m = 0;
+    ln_.g.m = 0;
     curve_ = nullptr;
     active_ = false;
 }
@@ -364,25 +364,25 @@ void StepGen::fill_line(RunQueue& q) {
     while (active_ && !stopped_) {
         // Room for the worst case of one segment: m runs, each possibly split in two; and no
         // more than the horizon committed ahead of the interrupt.
-        if (q.free_slots() < 2 * line_.m) break;
+        if (q.free_slots() < 2 * ln_.g.m) break;
         if (queued_cycles(q) >= kHorizonCycles) break;
-        uint32_t left = line_.dist[0] - cursor_.x1;
+        uint32_t left = ln_.g.dist[0] - ln_.c.x1;
         uint8_t len = left < seg_len_ ? static_cast<uint8_t>(left) : seg_len_;
         uint32_t delta;
-        if (!delta_at(2 * (cursor_.x1 - origin_) + len, delta)) break; // segment midpoint
+        if (!delta_at(2 * (ln_.c.x1 - origin_) + len, delta)) break; // segment midpoint
         uint8_t e[kAxes];
-        line_advance(line_, cursor_, len, e);
+        line_advance(ln_.g, ln_.c, len, e);
         MicroRun runs[kAxes];
-        uint8_t n = micro_split(e, line_.m, runs);
+        uint8_t n = micro_split(e, ln_.g.m, runs);
         for (uint8_t i = 0; i < n; ++i) {
             uint8_t idx = static_cast<uint8_t>(runs[i].set >> 1);
-            emit(q, k_mask_[idx], line_.dirs, runs[i].count, mul_shr(delta, k_[idx], 20));
+            emit(q, ln_.mask[idx], ln_.g.dirs, runs[i].count, mul_shr(delta, ln_.k[idx], 20));
         }
 #if LL_STATS
         ++stats.segments;
 #endif
-        seg_len_ = next_segment(delta, mul_shr(delta, kmax_, 20));
-        if (cursor_.x1 == line_.dist[0]) finish_move();
+        seg_len_ = next_segment(delta, mul_shr(delta, ln_.kmax, 20));
+        if (ln_.c.x1 == ln_.g.dist[0]) finish_move();
     }
 }
 
@@ -394,11 +394,11 @@ void StepGen::fill_curve(RunQueue& q) {
         // The chord of the next sample sets the time of every sample of the segment (the
         // segment never crosses into the next piece, whose samples may be twice as long).
         int32_t d[3];
-        uint16_t left = walker_.peek(d);
+        uint16_t left = cv_.w.peek(d);
         Num sum{};
         for (uint8_t k = 0; k < 3; ++k) {
             Num v(abs32(d[k]));
-            v.mul(v).mul(lengths_->inv2[curve_axes_[k]]);
+            v.mul(v).mul(lengths_->inv2[cv_.axes[k]]);
             sum.add(v);
         }
         // mm over 2^16 -> µm x 256
@@ -406,7 +406,7 @@ void StepGen::fill_curve(RunQueue& q) {
         if (chord_q8 == 0) chord_q8 = 1;
         uint8_t n = seg_len_;
         if (left != 0 && left < n) n = static_cast<uint8_t>(left);
-        uint32_t mid = x_q8_ + chord_q8 * n / 2;
+        uint32_t mid = cv_.x_q8 + chord_q8 * n / 2;
         uint32_t delta;
         if (!delta_at(2 * ((mid >> 8) - origin_), delta)) break;
         // Delta (cycles x 256 per µm) x chord (µm x 256) / 256.
@@ -416,10 +416,10 @@ void StepGen::fill_curve(RunQueue& q) {
         uint8_t i = 0;
         for (; i < n; ++i) {
             uint8_t moved, neg;
-            if (!walker_.next(moved, neg)) break;
+            if (!cv_.w.next(moved, neg)) break;
             uint8_t steps = 0, dirs = 0;
             for (uint8_t k = 0; k < 3; ++k) {
-                uint8_t bit = static_cast<uint8_t>(1u << curve_axes_[k]);
+                uint8_t bit = static_cast<uint8_t>(1u << cv_.axes[k]);
                 if (moved & (1u << k)) steps = static_cast<uint8_t>(steps | bit);
                 if (neg & (1u << k)) dirs = static_cast<uint8_t>(dirs | bit);
             }
@@ -434,12 +434,12 @@ void StepGen::fill_curve(RunQueue& q) {
             ++run_count;
         }
         if (run_count != 0) emit(q, run_steps, run_dirs, run_count, period_q8);
-        x_q8_ += chord_q8 * i;
+        cv_.x_q8 += chord_q8 * i;
 #if LL_STATS
         ++stats.segments;
 #endif
         seg_len_ = next_segment(period_q8 < 1 ? 1 : period_q8, period_q8);
-        if (walker_.done()) finish_move();
+        if (cv_.w.done()) finish_move();
     }
 }
 

@@ -31,7 +31,9 @@ class GCode : public ::testing::Test {
     }
 
     uint8_t run(const std::string& line, uint8_t flags = 0) {
-        return gcode::execute(line.c_str(), flags, outcome);
+        uint8_t r = gcode::execute(line.c_str(), flags, outcome);
+        if (outcome.move) ll::motion::push_line(*outcome.move);
+        return r;
     }
     // Runs a line that must succeed, waiting out nothing (dwell lines are re-run as the protocol
     // does once the dwell is over).

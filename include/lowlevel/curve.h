@@ -123,14 +123,19 @@ class CurveWalker {
     int32_t end_[3];        ///< final position, ticks
     int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
     int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
-    // Arc: unit vector at the start of the next piece, rotation per piece, arm length (Q30).
-    int32_t centre_[2];
-    uint32_t radii_[2];
-    int32_t c_, s_, rot_c_, rot_s_, arm_;
-    int32_t end_c_, end_s_; ///< direction of the end point (the last piece lands there)
-    // Bezier: polynomial coefficients (ticks x 256), B(a) = c0 + c1 a + c2 a^2 + c3 a^3.
-    int64_t poly_[4][2];
-    uint8_t log_pieces_; ///< Bezier: 2^j pieces
+    int32_t end_c_, end_s_; ///< arc: direction of the end point; Bezier: the end (ticks x 256)
+    uint8_t log_pieces_;    ///< Bezier: 2^j pieces
+    // An arc or a Bezier, never both.
+    struct ArcState {
+        int32_t centre[2];
+        uint32_t radii[2];
+        int32_t c, s, rot_c, rot_s, arm; ///< unit vector of the next piece's start, rotation
+                                         ///< per piece and arm length, Q30
+    };
+    union {
+        ArcState a_;
+        int64_t poly_[4][2]; ///< Bezier: B(a) = c0 + c1 a + c2 a^2 + c3 a^3, ticks x 256
+    };
 };
 
 } // namespace ll

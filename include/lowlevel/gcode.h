@@ -5,6 +5,7 @@
 #pragma once
 
 #include "lowlevel/config.h"
+#include "lowlevel/motion.h"
 #include "lowlevel/numparse.h"
 #include "lowlevel/settings.h"
 
@@ -76,6 +77,9 @@ enum class Then : uint8_t {
 struct Outcome {
     Then then;
     uint32_t dwell_ms; ///< with kDwell
+    /// A move to queue, or nullptr. The caller hands it to motion::push_line() once execute()
+    /// has returned, so that planning the move does not stack on top of parsing the line.
+    const motion::LineRequest* move;
 };
 
 /// Parses and executes one line: upper case, no spaces, no comments, NUL-terminated (the

@@ -97,8 +97,8 @@ class StepGen {
     /// Speed at the end of the last produced segment, (mm/min)^2 of the current move's path.
     uint32_t speed2() const;
     /// Reference ticks left in the current move, and the move's reference length.
-    uint32_t remaining() const { return line_.dist[0] - cursor_.x1; }
-    uint32_t length() const { return line_.dist[0]; }
+    uint32_t remaining() const { return ref_len() - progress(); }
+    uint32_t length() const { return ref_len(); }
 
     /// Position after every run pushed so far, steps: the move's start plus the macro
     /// position reached (the interrupt never counts steps; this is derived when asked).
@@ -114,7 +114,7 @@ class StepGen {
 
     // Exposed for the tests: the prepared move.
     const LineGeometry& line() const {
-        return line_;
+        return ln_.g;
     }
     const Profile& profile() const {
         return prof_;
@@ -122,7 +122,7 @@ class StepGen {
     /// K table: normalised wait-time factor of each axis set containing the reference axis,
     /// indexed by (sorted-position set >> 1), Q16. Delta_P = K[P] * Delta_1 >> 16.
     uint32_t k(uint8_t index) const {
-        return k_[index];
+        return ln_.k[index];
     }
     uint8_t segment_ticks() const {
         return seg_len_;
@@ -144,10 +144,10 @@ class StepGen {
     void fill_curve(RunQueue& q);
     void finish_move();
     uint32_t ref_len() const {
-        return curve_ ? ref_um_ : line_.dist[0];
+        return curve_ ? cv_.ref_um : ln_.g.dist[0];
     }
     uint32_t progress() const {
-        return curve_ ? (x_q8_ >> 8) : cursor_.x1;
+        return curve_ ? (cv_.x_q8 >> 8) : ln_.c.x1;
     }
 
     // Most used first: the ATmega328P addresses the first 64 bytes of an object directly.
@@ -164,7 +164,6 @@ class StepGen {
     uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
     uint32_t a_last_;     ///< A of the last segment
     uint32_t delta_root_; ///< d_num / R for the current R
-    uint32_t kmax_;       ///< largest K of the move
     // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
     uint32_t a_hold_;
     uint32_t x2_hold_;
@@ -176,17 +175,26 @@ class StepGen {
     uint32_t len_q8_, accel_, feed_, v_nominal2_, v_exit2_;
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
-    // The move being produced: a line (line_, cursor_, K table) or a curve (walker_).
+    // The move being produced: a line or a curve, never both, so they share their memory.
     const CurveParams* curve_;
-    uint32_t ref_um_;       ///< curve: its length, µm (the profile's reference length)
-    uint32_t x_q8_;         ///< curve: distance travelled, µm x 256
-    uint8_t curve_axes_[3]; ///< curve: machine axes u, v, w
-    CurveWalker walker_;
-    LineGeometry line_;
-    LineCursor cursor_;
+    struct LineState {
+        LineGeometry g;
+        LineCursor c;
+        uint32_t kmax;                   ///< largest K of the move
+        uint32_t k[1u << (kAxes - 1)];   ///< K table, Q20 (see k())
+        uint8_t mask[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
+    };
+    struct CurveState {
+        CurveWalker w;
+        uint32_t ref_um; ///< its length, µm (the profile's reference length)
+        uint32_t x_q8;   ///< distance travelled, µm x 256
+        uint8_t axes[3]; ///< machine axes u, v, w
+    };
+    union {
+        LineState ln_;
+        CurveState cv_;
+    };
     int32_t start_[kAxes]; ///< position where the current (or last) move started, steps
-    uint32_t k_[1u << (kAxes - 1)];
-    uint8_t k_mask_[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
     // Duration of each queued run in 1024-cycle units (saturated), by queue slot: keeps the
     // horizon without any help from the interrupt.
     uint8_t slot_time_[kRunQueueSize];
