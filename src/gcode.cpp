@@ -116,30 +116,33 @@ const Command kCommands[] LL_PROGMEM = {
     {57, kGroupCoord, 3},
     {58, kGroupCoord, 4},
     {59, kGroupCoord, 5},
-    // G2 G3 G5 (and G2.1 G3.1 with the decimal) take their place here as motion commands that
-    // use the axis words, once their generators exist; until then they are error:20.
+    // Curves stepped in the low level (seed part IV, docs/curves.md).
+    {2, kGroupMotion, uint8_t(Motion::ArcCw) | kUsesAxes | kStrict},
+    {3, kGroupMotion, uint8_t(Motion::ArcCcw) | kUsesAxes | kStrict},
+    {2, kGroupMotion | dec1, uint8_t(Motion::EllipseCw) | kUsesAxes | kStrict},
+    {3, kGroupMotion | dec1, uint8_t(Motion::EllipseCcw) | kUsesAxes | kStrict},
+    {5, kGroupMotion, uint8_t(Motion::Bezier) | kUsesAxes | kStrict},
 };
 constexpr uint8_t kCommandCount = sizeof(kCommands) / sizeof(kCommands[0]);
 
 // Value words, numbered so that their bit in Block::words is their number: the axes first, then
-// F and P (kept as decimals until the units of the block are known), the other words.
-// I J K Q R are only recognised (the curves to come use them: G2/G3 I J K R P, G2.1/G3.1 and G5
-// I J P Q); a block that has one is refused as unused (36).
+// F, P and the curves' I J K Q R (kept as decimals until the units of the block are known), the
+// other words. I J K are the offsets along X Y Z (so kWordI + axis for X, Y, Z).
 enum Word : uint8_t {
     kWordF = kAxes,
     kWordP,
-    kWordN,
-    kWordL,
-    kWordS,
-    kWordT,
     kWordI,
     kWordJ,
     kWordK,
     kWordQ,
     kWordR,
+    kWordN,
+    kWordL,
+    kWordS,
+    kWordT,
     kWordCount
 };
-constexpr uint8_t kDecimalSlots = kWordP + 1;
+constexpr uint8_t kDecimalSlots = kWordR + 1;
 constexpr uint8_t kLetterG = 0xFD, kLetterM = 0xFE, kLetterNone = 0xFF;
 
 template <bool Small>
@@ -156,9 +159,9 @@ constexpr WordMask bit(uint8_t w) {
     return static_cast<WordMask>(WordMask(1) << w);
 }
 constexpr WordMask kAxisWords = static_cast<WordMask>(bit(kAxes) - 1);
-constexpr WordMask kNotNegative =
-    bit(kWordF) | bit(kWordP) | bit(kWordN) | bit(kWordS) | bit(kWordT);
-// Words that a command must consume (P, L) or that nothing consumes yet (I J K Q R).
+// (P may be negative in a G5 only: checked in stage 3.)
+constexpr WordMask kNotNegative = bit(kWordF) | bit(kWordN) | bit(kWordS) | bit(kWordT);
+// Words that a command must consume.
 constexpr WordMask kMustBeUsed =
     bit(kWordP) | bit(kWordL) | bit(kWordI) | bit(kWordJ) | bit(kWordK) | bit(kWordQ) | bit(kWordR);
 
@@ -180,7 +183,8 @@ const uint8_t kLetterInfo[26] LL_PROGMEM = {
 
 constexpr uint32_t kNoLineNumber = 0xFFFFFFFFu;
 
-// An axis, F or P word: the number as read, then (axes) its value in um once the units are known.
+// An axis, F, P, I J K Q R word: the number as read, then (axes) its value in um once the units
+// are known.
 union Slot {
     num::Decimal d;
     int32_t um;
@@ -215,6 +219,7 @@ struct Work {
         // block never moves).
         motion::LineRequest req;
     };
+    CurveParams curve; // stage 3 and 4 of a curve: handed to the planner with req
 };
 Work w;
 
@@ -329,6 +334,204 @@ void set_end_modes(Modal& m) {
     m.coolant = 9;
 }
 
+// sqrt(x^2 + y^2) for um values.
+Num hypot_um(int32_t x, int32_t y) {
+    Num a(abs32(x)), b(abs32(y));
+    Num aa = a, bb = b;
+    return aa.mul(a).add(bb.mul(b)).sqrt();
+}
+
+// |Num a - Num b| on a fixed-point scale: both are below 2^31 here (um lengths).
+uint32_t diff_um(const Num& a, const Num& b) {
+    uint32_t x = a.u32(), y = b.u32();
+    return x > y ? x - y : y - x;
+}
+
+// Distance (um, approximate: |F| / |grad F| with F = (x/p)^2 + (y/q)^2 - 1) from (x, y) to the
+// ellipse of semi-axes p, q centred on the origin.
+uint32_t ellipse_gap_um(int32_t x, int32_t y, uint32_t p, uint32_t q) {
+    Num a(abs32(x)), b(abs32(y));
+    a.div(p);
+    b.div(q);
+    Num aa = a, bb = b;
+    Num f = aa.mul(a).add(bb.mul(b));   // (x/p)^2 + (y/q)^2
+    uint32_t f_q30 = f.shift(30).u32(); // saturates far from the curve
+    uint32_t off = f_q30 > (1ul << 30) ? f_q30 - (1ul << 30) : (1ul << 30) - f_q30;
+    Num gx = a, gy = b;
+    gx.div(p);
+    gy.div(q);
+    Num g = gx.mul(gx).add(gy.mul(gy)).sqrt().shift(1); // |grad F|, per um
+    if (g.m == 0) return 0xFFFFFFFFul;
+    return Num(off).shift(-30).div(g).u32();
+}
+
+// A length word of the block (um), or `dflt` when absent; false on overflow.
+bool word_um(const Block& b, uint8_t word, int32_t dflt, int32_t& out) {
+    if (!(b.words & bit(word))) {
+        out = dflt;
+        return true;
+    }
+    return length(b, b.v[word].d, out);
+}
+
+// Stage 3 of a curve (docs/curves.md): the checks and errors of GRBL's arcs (26 32 33 34 35), our
+// extensions' (ellipses, G5), and the geometry handed to the planner. Consumes its words.
+uint8_t check_curve(Block& b, Motion motion, uint8_t axes, const State& st, CurveParams& c) {
+    uint8_t ax[3];
+    c.plane = b.g[kGroupPlane];
+    plane_axes(c.plane, ax);
+    const uint8_t u = ax[0], v = ax[1];
+    const uint8_t in_plane = static_cast<uint8_t>((1u << u) | (1u << v));
+    // A curve moves the plane's axes and, along a helix, the normal one: not the others.
+    if (axes & ~(in_plane | (1u << ax[2]))) return kAxisWordsExist;
+    const WordMask wi = bit(static_cast<uint8_t>(kWordI + u)),
+                   wj = bit(static_cast<uint8_t>(kWordI + v));
+    bool ellipse = motion == Motion::EllipseCw || motion == Motion::EllipseCcw;
+    if (!ellipse && axes == 0) return kNoAxisWords;
+    if (!ellipse && motion != Motion::Bezier && !(axes & in_plane)) return kNoAxisWordsInPlane;
+    c.kind = motion == Motion::Bezier ? kCurveBezier : kCurveArc;
+    c.clockwise = motion == Motion::ArcCw || motion == Motion::EllipseCw;
+    c.turns = 0;
+    c.start_um[0] = st.position[u];
+    c.start_um[1] = st.position[v];
+    c.end_um[0] = w.req.target_um[u];
+    c.end_um[1] = w.req.target_um[v];
+    int32_t x = add(c.end_um[0], c.start_um[0], true), y = add(c.end_um[1], c.start_um[1], true);
+    int32_t ou, ov, pw, qw;
+    if (!word_um(b, static_cast<uint8_t>(kWordI + u), 0, ou) ||
+        !word_um(b, static_cast<uint8_t>(kWordI + v), 0, ov) || !word_um(b, kWordP, 0, pw) ||
+        !word_um(b, kWordQ, 0, qw)) {
+        return kBadNumberFormat;
+    }
+    bool has_offsets = (b.words & (wi | wj)) != 0;
+    bool has_pq = (b.words & bit(kWordP)) && (b.words & bit(kWordQ));
+    const WordMask ijk = bit(kWordI) | bit(kWordJ) | bit(kWordK);
+    WordMask used = static_cast<WordMask>(ijk | bit(kWordP) | bit(kWordQ)); // G2.1, G3.1, G5
+    if (motion == Motion::Bezier) {
+        // G5 (Marlin): I J the first control point from the start (or, after a G5, the
+        // reflection of its second one), P Q the second control point from the end.
+        if (!has_pq) return kValueWordMissing;
+        if (!has_offsets) {
+            if (!st.g5_continues) return kValueWordMissing;
+            ou = st.g5_reflect[0];
+            ov = st.g5_reflect[1];
+        }
+        c.a_um[0] = add(c.start_um[0], ou);
+        c.a_um[1] = add(c.start_um[1], ov);
+        c.b_um[0] = add(c.end_um[0], pw);
+        c.b_um[1] = add(c.end_um[1], qw);
+    } else if (ellipse) {
+        // G2.1 / G3.1: I J the centre from the start, P Q the semi-axes along the plane's
+        // axes; both ends on the ellipse within one tick + 0.002 mm.
+        if (!has_offsets) return kNoOffsetsInPlane;
+        if (!has_pq) return kValueWordMissing;
+        if (pw <= 0 || qw <= 0) return kNegativeValue;
+        c.a_um[0] = add(c.start_um[0], ou);
+        c.a_um[1] = add(c.start_um[1], ov);
+        c.b_um[0] = pw;
+        c.b_um[1] = qw;
+        uint32_t tick = 0;
+        for (uint8_t k = 0; k < 2; ++k) {
+            uint32_t t = 1000000ul / g_settings.axis[ax[k]].steps_per_unit; // um per step
+            if (t > tick) tick = t;
+        }
+        uint32_t tol = tick + 2;
+        if (ellipse_gap_um(-ou, -ov, static_cast<uint32_t>(pw), static_cast<uint32_t>(qw)) > tol ||
+            ellipse_gap_um(add(c.end_um[0], c.a_um[0], true), add(c.end_um[1], c.a_um[1], true),
+                           static_cast<uint32_t>(pw), static_cast<uint32_t>(qw)) > tol) {
+            return kInvalidTarget;
+        }
+    } else {
+        // G2 / G3, as GRBL: radius mode (R) or centre mode (the plane's offsets).
+        int32_t i, j;
+        uint32_t r;
+        used = bit(kWordP);
+        if (b.words & bit(kWordR)) {
+            used = static_cast<WordMask>(used | bit(kWordR)); // I J K stay unused (GRBL: 36)
+            int32_t rw;
+            if (!length(b, b.v[kWordR].d, rw)) return kBadNumberFormat;
+            if (x == 0 && y == 0) return kInvalidTarget;
+            // Centre on the perpendicular bisector: h = -sqrt(4 r^2 - d^2) / d, negated for
+            // G3 and for a negative R (the longer arc).
+            Num d = hypot_um(x, y);
+            Num r2(abs32(rw));
+            r2.mul(r2).mul(4u);
+            Num d2 = d;
+            d2.mul(d);
+            if (r2.cmp(d2) < 0) return kArcRadiusError;
+            uint32_t rr = r2.shift(-16).u32(), dd = d2.shift(-16).u32(); // both below 2^32
+            Num h(rr - dd, 16);
+            h.sqrt().div(d);                                      // |h|
+            bool neg = !((motion == Motion::ArcCcw) != (rw < 0)); // -sqrt(..), flipped
+            int32_t hy = static_cast<int32_t>(h.of(abs32(y))),
+                    hx = static_cast<int32_t>(h.of(abs32(x)));
+            if ((y < 0) != neg) hy = -hy;
+            if ((x < 0) != neg) hx = -hx;
+            i = (x - hy) / 2; // (x - y h) / 2
+            j = (y + hx) / 2; // (y + x h) / 2
+            r = abs32(rw);
+        } else {
+            if (!has_offsets) return kNoOffsetsInPlane;
+            used = static_cast<WordMask>(used | ijk);
+            i = ou;
+            j = ov;
+            Num rn = hypot_um(i, j);
+            r = rn.u32();
+            // The end must be on the circle: within 0.005 mm, or else within 0.5 mm and 0.1 %.
+            uint32_t delta = diff_um(hypot_um(add(x, i, true), add(y, j, true)), rn);
+            if (delta > 5 && (delta > 500 || delta > r / 1000)) return kInvalidTarget;
+        }
+        if (r == 0) return kInvalidTarget;
+        c.a_um[0] = add(c.start_um[0], i);
+        c.a_um[1] = add(c.start_um[1], j);
+        c.b_um[0] = static_cast<int32_t>(r);
+        c.b_um[1] = static_cast<int32_t>(r);
+        if (b.words & bit(kWordP)) { // LinuxCNC: P turns, P1 the plain arc
+            uint32_t turns;
+            if (!num::to_uint(b.v[kWordP].d, 256u, turns)) return kCommandValueNotInteger;
+            if (turns == 0) return kInvalidTarget;
+            c.turns = static_cast<uint8_t>(turns - 1);
+        }
+    }
+    // The step generator's fixed-point range (docs/curves.md), else error:33: the ends, the
+    // control points or the centre, and the semi-axes, within 2^22 steps; the length within
+    // 2^23 um (an arc's is at most its larger semi-axis times its sweep; a Bezier's at most its
+    // control polygon's), and the normal axis' travel too.
+    uint32_t reach = 0; // length bound, um / 2
+    for (uint8_t k = 0; k < 2; ++k) {
+        const int32_t pts[4] = {c.start_um[k], c.end_um[k], c.a_um[k], c.b_um[k]};
+        for (int32_t p : pts) {
+            int32_t steps;
+            if (!num::mul_div_round(p, g_settings.axis[ax[k]].steps_per_unit, 1000000u, steps) ||
+                abs32(steps) > (1l << 22)) {
+                return kInvalidTarget;
+            }
+        }
+        if (c.kind == kCurveBezier) {
+            reach += abs32(c.a_um[k] - c.start_um[k]) / 2 + abs32(c.b_um[k] - c.a_um[k]) / 2 +
+                     abs32(c.end_um[k] - c.b_um[k]) / 2;
+        }
+    }
+    if (c.kind == kCurveArc) {
+        const uint32_t radii[2] = {static_cast<uint32_t>(c.b_um[0]),
+                                   static_cast<uint32_t>(c.b_um[1])};
+        int32_t c0, s0, c1, s1;
+        ellipse_direction(c.start_um[0] - c.a_um[0], c.start_um[1] - c.a_um[1], radii, c0, s0);
+        ellipse_direction(c.end_um[0] - c.a_um[0], c.end_um[1] - c.a_um[1], radii, c1, s1);
+        int64_t sweep = arc_sweep_q29(c0, s0, c1, s1, c.clockwise != 0, c.turns);
+        uint64_t mag = static_cast<uint64_t>(sweep < 0 ? -sweep : sweep);
+        uint32_t r = radii[0] > radii[1] ? radii[0] : radii[1];
+        // r |sweep| / 2, |sweep| < 2^40 (Q29, 256 turns), r < 2^31.
+        uint64_t half = (static_cast<uint64_t>(r) * (mag >> 14)) >> 16;
+        reach = half > 0xFFFFFFFFull ? 0xFFFFFFFFul : static_cast<uint32_t>(half);
+    }
+    reach += abs32(w.req.target_um[ax[2]] - st.position[ax[2]]) / 2;
+    if (reach >= (1ul << 22)) return kInvalidTarget;
+    if (b.overflow) return kInvalidTarget;
+    b.words = static_cast<WordMask>(b.words & ~used);
+    return kOk;
+}
+
 } // namespace
 
 uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
@@ -375,8 +578,19 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     uint8_t non_modal = b.g[kGroupNonModal];
     Motion motion = static_cast<Motion>(b.g[kGroupMotion]);
     uint8_t axes = static_cast<uint8_t>(b.words & kAxisWords);
-    // [0] Axis words without a command that uses them: the current motion mode does.
+    // [0] Axis words without a command that uses them: the current motion mode does; so do the
+    // words of an ellipse without an end point (a full ellipse, docs/curves.md).
     if (axes != 0 && b.axis_command == kAxisNone) b.axis_command = kAxisMotion;
+    bool ellipse = motion == Motion::EllipseCw || motion == Motion::EllipseCcw;
+    if (ellipse && b.axis_command == kAxisNone &&
+        (b.words & (bit(kWordI) | bit(kWordJ) | bit(kWordK) | bit(kWordP) | bit(kWordQ)))) {
+        b.axis_command = kAxisMotion;
+    }
+    // P: negative only as a G5 control point offset (GRBL refuses a negative P as error:4).
+    if ((b.words & bit(kWordP)) && b.v[kWordP].d.negative() &&
+        !(motion == Motion::Bezier && b.axis_command == kAxisMotion)) {
+        return kNegativeValue;
+    }
     if ((b.words & bit(kWordN)) && b.n == kNoLineNumber) return kInvalidLineNumber;
 
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
@@ -471,11 +685,18 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     }
 
     // [20] Motion modes.
+    bool curve = false;
     if (motion == Motion::None) {
         if (axes != 0) return kAxisWordsExist;
     } else if (b.axis_command == kAxisMotion) {
         if (motion != Motion::Seek && b.feed == 0) return kUndefinedFeedRate;
-        if (axes == 0) b.axis_command = kAxisNone; // G0/G1 alone: a mode change only
+        if (motion >= Motion::ArcCw && motion <= Motion::Bezier) {
+            uint8_t r = check_curve(b, motion, axes, st, w.curve);
+            if (r != kOk) return r;
+            curve = true;
+        } else if (axes == 0) {
+            b.axis_command = kAxisNone; // G0/G1 alone: a mode change only
+        }
     }
 
     // [0] Every word must have been used.
@@ -493,7 +714,9 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         if ((offsets || non_modal == kResetOffset) && motion::state() != motion::State::Idle) {
             return kRetryWhenIdle;
         }
-        if (moves && !motion::can_accept()) return kRetryWhenAccepting;
+        if (moves && !(curve ? motion::can_accept_curve() : motion::can_accept())) {
+            return kRetryWhenAccepting;
+        }
     }
 
     // ---- Stage 4: execute, in GRBL's order.
@@ -512,7 +735,13 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     if (moves) {
         req.feed = b.feed;
         req.rapid = motion == Motion::Seek;
+        req.curve = curve ? &w.curve : nullptr;
         if (!check) outcome.move = &req; // queued by the caller; the length was checked above
+        // A G5 without I J continues the last G5 smoothly: remember its second arm.
+        st.g5_continues = motion == Motion::Bezier;
+        if (st.g5_continues) {
+            for (uint8_t k = 0; k < 2; ++k) st.g5_reflect[k] = w.curve.end_um[k] - w.curve.b_um[k];
+        }
         copy_words(st.position, req.target_um, kAxes);
         copy_words(st.position_steps, req.target_steps, kAxes);
     }

@@ -104,10 +104,20 @@ bool can_accept() {
     return !mo().planner.full();
 }
 
+bool can_accept_curve() {
+    return can_accept() && mo().planner.curve_slot_free();
+}
+
 bool push_line(const LineRequest& req) {
     Motion& m = mo();
     if (too_long(m.planner.last_target(), req.target_steps)) return false;
-    m.planner.add(req.target_steps, req.target_um, req.feed, req.rapid);
+    if (req.curve) {
+        if (!m.planner.add_curve(req.target_steps, req.target_um, req.feed, *req.curve)) {
+            return false;
+        }
+    } else {
+        m.planner.add(req.target_steps, req.target_um, req.feed, req.rapid);
+    }
     if (!m.planner.empty() && m.state == State::Idle) m.state = State::Cycle;
     poll();
     return true;

@@ -42,6 +42,17 @@ Num norm(const uint32_t v[kAxes]) {
     return sum.sqrt();
 }
 
+// Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
+// of the plane's two axes bounds it (and the normal axis' when a helix moves it).
+uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
+    uint8_t ax[3];
+    plane_axes(plane, ax);
+    uint32_t acc = 0xFFFFFFFFul;
+    for (uint8_t k = 0; k < (w_moves ? 3 : 2); ++k) acc = min32(acc, m.settings->axis[ax[k]].accel);
+    uint32_t v = Num(acc).mul(18).div(5).u32(); // units/s^2 x1000 -> units/min^2
+    return v ? v : 1;
+}
+
 } // namespace
 
 void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out) {
@@ -69,6 +80,7 @@ int32_t Planner::delta(const PlanBlock& b, uint8_t axis) {
 void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
     head_ = 0;
     count_ = 0;
+    curve_used_ = 0;
     first_begun_ = 0;
     prev_group_ = 0;
     for (uint8_t a = 0; a < kAxes; ++a) {
@@ -151,14 +163,74 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (u > (1ul << 29)) u = 1ul << 29;
         unit[a] = du[a] < 0 ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
-    uint32_t v_junction2 = prev_group_ == b.group && count_ > 0 ? junction2(unit) : 0;
-    for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
+    b.curve = 0;
+    finish_block(b, unit, unit);
+    return true;
+}
+
+void Planner::finish_block(PlanBlock& b, const int32_t unit_in[kAxes],
+                           const int32_t unit_out[kAxes]) {
+    uint32_t v_junction2 = prev_group_ == b.group && count_ > 0 ? junction2(unit_in) : 0;
+    for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit_out[a];
     uint32_t prev_nominal2 = count_ > 0 ? nominal2(ring_[index(count_ - 1)]) : 0;
     prev_group_ = b.group;
     b.v_max_entry2 = min32(v_junction2, min32(nominal2(b), prev_nominal2));
     b.v_entry2 = 0;
     ++count_;
     recalculate();
+}
+
+bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
+                        const CurveParams& curve) {
+    uint8_t ax[3];
+    plane_axes(curve.plane, ax);
+    int32_t d[kAxes];
+    for (uint8_t a = 0; a < kAxes; ++a) d[a] = target[a] - last_[a];
+    const uint8_t group = m_->group_of[ax[0] < ax[1] ? ax[0] : ax[1]];
+    const bool w_reg = (group & (1u << ax[2])) != 0;
+    const int32_t dw_um = target_um[ax[2]] - last_um_[ax[2]];
+    CurveShape shape;
+    if (!curve_shape(curve, w_reg ? dw_um : 0, w_reg, shape)) return false;
+    uint8_t slot = 0;
+    while (curve_used_ & (1u << slot)) ++slot;
+    curve_used_ = static_cast<uint8_t>(curve_used_ | (1u << slot));
+    curves_[slot] = curve;
+    curves_[slot].len_q8 = shape.len_q8;
+    PlanBlock& b = ring_[index(count_)];
+    b.curve = static_cast<uint8_t>(slot + 1);
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        last_[a] = target[a];
+        last_um_[a] = target_um[a];
+        uint32_t v = static_cast<uint32_t>(d[a]);
+        b.delta[a][0] = static_cast<uint8_t>(v);
+        b.delta[a][1] = static_cast<uint8_t>(v >> 8);
+        b.delta[a][2] = static_cast<uint8_t>(v >> 16);
+    }
+    b.group = group;
+    // Speed: the requested feed, within the plane axes' rates (the tangent takes every
+    // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L), and
+    // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
+    // sqrt(a r 1000) with a in units/min^2 and r in µm.
+    const Settings& st = *m_->settings;
+    uint32_t vmax = min32(st.axis[ax[0]].max_rate, st.axis[ax[1]].max_rate);
+    if (dw_um != 0) {
+        uint32_t vw =
+            Num(st.axis[ax[2]].max_rate).mul(shape.len_q8).div(abs32(dw_um)).shift(-8).u32();
+        vmax = min32(vmax, vw);
+    }
+    const uint32_t accel = curve_accel(*m_, curve.plane, d[ax[2]] != 0);
+    vmax = min32(vmax, Num(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
+    b.feed = min32(feed, vmax);
+    if (b.feed == 0) b.feed = 1;
+    b.dv2 = Num(shape.len_q8).mul(accel).div(128000).u32();
+    // Junctions from the tangents at both ends (w counts only when it is regulated).
+    int32_t in[kAxes] = {}, out[kAxes] = {};
+    for (uint8_t k = 0; k < 3; ++k) {
+        if (k == 2 && !w_reg) continue;
+        in[ax[k]] = shape.start_dir[k];
+        out[ax[k]] = shape.end_dir[k];
+    }
+    finish_block(b, in, out);
     return true;
 }
 
@@ -184,16 +256,25 @@ MoveSpec Planner::spec_of_first() const {
     const PlanBlock& b = ring_[head_];
     MoveSpec s;
     for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(b, a);
-    MoveLimits lim;
-    move_limits(*m_, s.delta, b.group, lim);
-    s.len_q8 = lim.len_q8;
-    s.accel = lim.accel;
+    if (b.curve) {
+        const CurveParams& c = curves_[b.curve - 1];
+        s.len_q8 = c.len_q8;
+        uint8_t ax[3];
+        plane_axes(c.plane, ax);
+        s.accel = curve_accel(*m_, c.plane, s.delta[ax[2]] != 0);
+        s.curve = &c;
+    } else {
+        MoveLimits lim;
+        move_limits(*m_, s.delta, b.group, lim);
+        s.len_q8 = lim.len_q8;
+        s.accel = lim.accel;
+        s.curve = nullptr;
+    }
     s.feed = b.feed;
     s.v_entry2 = b.v_entry2;
     s.v_nominal2 = nominal2(b);
     s.v_exit2 = exit2_of_first();
     s.group = b.group;
-    s.curve = nullptr;
     return s;
 }
 
@@ -203,6 +284,8 @@ uint32_t Planner::exit2_of_first() const {
 
 void Planner::discard_first() {
     if (!count_) return;
+    const PlanBlock& b = ring_[head_];
+    if (b.curve) curve_used_ = static_cast<uint8_t>(curve_used_ & ~(1u << (b.curve - 1)));
     head_ = index(1);
     --count_;
     first_begun_ = 0;

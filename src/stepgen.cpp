@@ -116,6 +116,13 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     if (!um_q8_per_step_) return false;
     ln_.g.m = 0;
     plane_axes(c.plane, cv_.axes);
+    // The path is timed along the regulated axes only (seed §3.1): the plane's, and the normal
+    // axis' when it belongs to the group (the planner measured the length the same way).
+    cv_.chord = 0;
+    for (uint8_t k = 0; k < 3; ++k) {
+        if (k < 2 || (spec.group & (1u << cv_.axes[k])))
+            cv_.chord = static_cast<uint8_t>(cv_.chord | (1u << k));
+    }
     // Machine positions (ticks) and commanded points of the plane (ticks x 256) for the walker:
     // µm x steps per µm, i.e. x 256 / (µm x 256 per step).
     CurveWalker::Ends e;
@@ -388,8 +395,11 @@ void StepGen::fill_line(RunQueue& q) {
 
 void StepGen::fill_curve(RunQueue& q) {
     while (active_ && !stopped_) {
-        // Worst case of one segment: every sample its own run, each possibly split in two.
-        if (q.free_slots() < 2 * kMaxSegmentTicks + 2) break;
+        // Worst case of one segment: every sample its own run, each possibly split in two; a
+        // segment is cut short to what the queue can take.
+        const uint8_t free = q.free_slots();
+        if (free < 4) break;
+        const uint8_t cap = static_cast<uint8_t>((free - 2) / 2);
         if (queued_cycles(q) >= kHorizonCycles) break;
         // The chord of the next sample sets the time of every sample of the segment (the
         // segment never crosses into the next piece, whose samples may be twice as long).
@@ -397,6 +407,7 @@ void StepGen::fill_curve(RunQueue& q) {
         uint16_t left = cv_.w.peek(d);
         Num sum{};
         for (uint8_t k = 0; k < 3; ++k) {
+            if (!(cv_.chord & (1u << k))) continue;
             Num v(abs32(d[k]));
             v.mul(v).mul(lengths_->inv2[cv_.axes[k]]);
             sum.add(v);
@@ -404,7 +415,7 @@ void StepGen::fill_curve(RunQueue& q) {
         // mm over 2^16 -> µm x 256
         uint32_t chord_q8 = sum.sqrt().mul(256000).shift(-16).u32();
         if (chord_q8 == 0) chord_q8 = 1;
-        uint8_t n = seg_len_;
+        uint8_t n = seg_len_ < cap ? seg_len_ : cap;
         if (left != 0 && left < n) n = static_cast<uint8_t>(left);
         uint32_t mid = cv_.x_q8 + chord_q8 * n / 2;
         uint32_t delta;

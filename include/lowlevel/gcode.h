@@ -49,6 +49,8 @@ struct State {
     int32_t g54[kAxes];            ///< G54 work offset, um (kept in EEPROM)
     int32_t g92[kAxes];            ///< G92 offset, um (RAM only; reset clears it)
     uint8_t wco_changed;           ///< set when G54/G92 change (the next status report shows WCO)
+    uint8_t g5_continues;          ///< the last move was a G5: a G5 without I J continues it
+    int32_t g5_reflect[2];         ///< last G5: end minus second control point (plane u, v), um
 };
 
 extern State g_state;

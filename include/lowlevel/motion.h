@@ -3,16 +3,20 @@
 #pragma once
 
 #include "lowlevel/config.h"
+#include "lowlevel/curve.h"
 
 namespace ll {
 namespace motion {
 
-/// One straight move in machine coordinates.
+/// One move in machine coordinates: straight, or along a curve (seed part IV).
 struct LineRequest {
     int32_t target_steps[kAxes]; ///< absolute target, steps: round_half_away(mm * steps/mm)
     int32_t target_um[kAxes];    ///< absolute target, mm x1000 (deg x1000 on a rotary axis)
     uint32_t feed;               ///< F in units/min x1000; ignored when `rapid`
     bool rapid;                  ///< G0: as fast as every axis allows
+    /// The curve from the current position to the target, or nullptr for a straight move.
+    /// Copied by push_line(); its len_q8 is computed there.
+    const CurveParams* curve;
 };
 
 /// Power-up state: position zero, nothing queued, step timer stopped. Call once before
@@ -21,6 +25,8 @@ void init();
 
 /// True when the planner has room for one more move.
 bool can_accept();
+/// True when the planner has room for one more curve (curves also need one of a few slots).
+bool can_accept_curve();
 /// Queues a move. Precondition: can_accept(). A move of zero length is dropped silently (as
 /// GRBL does) but still counts as accepted. Returns false, queueing nothing, when one axis
 /// would travel more than kMaxLineTicks steps (2^23 - 1) in one move: the G-code layer reports it

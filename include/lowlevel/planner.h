@@ -13,9 +13,13 @@
 
 namespace ll {
 
+/// Curves queued at once (each keeps its geometry in a slot: RAM is the limit).
+constexpr uint8_t kCurveSlots = 2;
+
 struct PlanBlock {
     uint8_t delta[kAxes][3]; ///< steps per machine axis, signed 24-bit little-endian
     uint8_t group;           ///< regulated axes (seed §3.1)
+    uint8_t curve;           ///< 0: a straight move; else 1 + the slot of its curve
     uint32_t feed;           ///< nominal speed, units/min x1000
     uint32_t dv2;            ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
     uint32_t v_entry2;       ///< planned entry speed squared
@@ -52,6 +56,14 @@ class Planner {
     /// travels more than kMaxLineTicks.
     bool add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
              bool rapid);
+    /// Queues a curve (seed part IV) from the last target to `target` along `curve` (its
+    /// len_q8 is computed here): its length, its curvature limit (v^2 <= a r) and its end
+    /// tangents (for the junctions) come from curve_shape(). Returns false for a degenerate
+    /// curve. Precondition: curve_slot_free() and !full().
+    bool add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
+                   const CurveParams& curve);
+    /// A curve needs one of kCurveSlots slots besides its block.
+    bool curve_slot_free() const { return curve_used_ != (1u << kCurveSlots) - 1; }
 
     /// The i-th queued move (0 = oldest). Precondition: i < count().
     const PlanBlock& block(uint8_t i) const { return ring_[index(i)]; }
@@ -79,7 +91,11 @@ class Planner {
     void recalculate();
     uint32_t junction2(const int32_t unit[kAxes]) const;
 
+    void finish_block(PlanBlock& b, const int32_t unit_in[kAxes], const int32_t unit_out[kAxes]);
+
     const Machine* m_;
+    uint8_t curve_used_; ///< bit i: curves_[i] belongs to a queued move
+    CurveParams curves_[kCurveSlots];
     uint8_t head_;
     uint8_t count_;
     uint8_t first_begun_; ///< the oldest move is in the step generator: its entry is fixed
