@@ -291,9 +291,8 @@ TEST_F(GCode, Error4NegativeValue) {
 }
 
 TEST_F(GCode, Error20UnsupportedCommand) {
-    for (const char* line :
-         {"G28", "G38.2Z-1", "G93",
-          "G90.1", "G92.2", "G61.1", "M6", "M7", "G-1", "M-1", "D1", "W1", "B1", "G10L5P1X0"}) {
+    for (const char* line : {"G28", "G38.2Z-1", "G93", "G90.1", "G92.2", "G61.1", "M6", "M7", "G-1",
+                             "M-1", "D1", "W1", "B1", "G10L5P1X0"}) {
         rejected(line, status::kUnsupportedCommand);
     }
 }
