@@ -102,6 +102,7 @@ std::vector<Reply> Grbl::stream(const std::vector<std::string>& lines, uint64_t 
 }
 
 std::string Grbl::status(uint64_t max_cycles) {
+    take_acks(); // reports already received (an earlier '?') are not the answer to this one
     const size_t seen = others_.size();
     sim_.send("?");
     const uint64_t limit = sim_.deadline(max_cycles);
