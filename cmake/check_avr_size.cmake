@@ -1,5 +1,8 @@
-# Fails when an AVR image exceeds its flash or static RAM budget.
-# Usage: cmake -DSIZE=avr-size -DFILE=<elf> -DFLASH_BUDGET=<bytes> -DRAM_BUDGET=<bytes> -P ...
+# Prints an AVR image's flash and static RAM use against its budget and the chip.
+# Usage: cmake -DSIZE=avr-size -DFILE=<elf> -DFLASH_BUDGET=<bytes> -DRAM_BUDGET=<bytes>
+#              -DCHIP_FLASH=<bytes> -DCHIP_RAM=<bytes> [-DSTRICT=1] -P check_avr_size.cmake
+# Fails when the image cannot fit the chip; with STRICT (the ctest check), also when it is over
+# budget.
 execute_process(COMMAND ${SIZE} -A ${FILE} OUTPUT_VARIABLE out RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "${SIZE} failed on ${FILE}")
@@ -15,10 +18,23 @@ foreach(sec text data bss noinit)
 endforeach()
 math(EXPR flash "${text} + ${data}")
 math(EXPR ram "${data} + ${bss} + ${noinit}")
-message(STATUS "${FILE}: flash ${flash} / ${FLASH_BUDGET} bytes, static RAM ${ram} / ${RAM_BUDGET} bytes")
+message(STATUS "${FILE}: flash ${flash} bytes (budget ${FLASH_BUDGET}, chip ${CHIP_FLASH}), "
+               "static RAM ${ram} bytes (budget ${RAM_BUDGET}, chip ${CHIP_RAM})")
+if(flash GREATER CHIP_FLASH OR ram GREATER CHIP_RAM)
+  message(FATAL_ERROR "${FILE} does not fit the ATmega328P")
+endif()
+set(over "")
 if(flash GREATER FLASH_BUDGET)
-  message(FATAL_ERROR "${FILE}: flash ${flash} bytes exceeds LL_FLASH_BUDGET (${FLASH_BUDGET})")
+  math(EXPR by "${flash} - ${FLASH_BUDGET}")
+  string(APPEND over " flash over budget by ${by} bytes;")
 endif()
 if(ram GREATER RAM_BUDGET)
-  message(FATAL_ERROR "${FILE}: static RAM ${ram} bytes exceeds LL_RAM_BUDGET (${RAM_BUDGET})")
+  math(EXPR by "${ram} - ${RAM_BUDGET}")
+  string(APPEND over " static RAM over budget by ${by} bytes;")
+endif()
+if(over)
+  if(STRICT)
+    message(FATAL_ERROR "${FILE}:${over} see docs/firmware.md")
+  endif()
+  message(WARNING "${FILE}:${over} the ctest check FirmwareBudget fails until it is fixed")
 endif()

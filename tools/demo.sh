@@ -27,26 +27,14 @@ quiet() {
 step "building the firmware (cmake --preset avr)"
 elf=build/avr/firmware/lowlevel.elf
 cmake --preset avr >"$logs/avr-configure.log" 2>&1 || { tail -20 "$logs/avr-configure.log"; exit 1; }
-if quiet "$logs/avr-build.log" cmake --build --preset avr; then
-  :
-elif grep -q "exceeds LL_\(FLASH\|RAM\)_BUDGET" "$logs/avr-build.log"; then
-  echo
-  echo "   !! SIZE BUDGET CHECK FAILED: the image is larger than firmware/CMakeLists.txt allows"
-  grep -h -E -- "-- lowlevel.elf: flash|exceeds LL_" "$logs/avr-build.log" | sed 's/^ */   !! /'
-  echo "   !! (full log: $logs/avr-build.log). The demo goes on with the same sources built"
-  echo "   !! without the budget check, in build/avr-nobudget."
-  echo
-  quiet "$logs/avr-nobudget-configure.log" cmake -S . -B build/avr-nobudget \
-    -DCMAKE_TOOLCHAIN_FILE="$PWD/cmake/avr-gcc.cmake" -DCMAKE_BUILD_TYPE=MinSizeRel \
-    -DLL_FLASH_BUDGET=32256 -DLL_RAM_BUDGET=2048 ||
-    { tail -20 "$logs/avr-nobudget-configure.log"; exit 1; }
-  quiet "$logs/avr-nobudget-build.log" cmake --build build/avr-nobudget --target lowlevel.elf -j2 ||
-    { tail -30 "$logs/avr-nobudget-build.log"; exit 1; }
-  elf=build/avr-nobudget/firmware/lowlevel.elf
-else
+if ! quiet "$logs/avr-build.log" cmake --build --preset avr; then
   tail -30 "$logs/avr-build.log"
   echo "demo: the firmware build failed (log: $logs/avr-build.log)"
   exit 1
+fi
+if grep -q "over budget" "$logs/avr-build.log"; then
+  echo "   !! over the size budget of issue 3 (the image still fits the chip and runs):"
+  grep -h -o "lowlevel.elf:.*over budget[^;]*;.*" "$logs/avr-build.log" | head -1 | sed 's/^/   !! /'
 fi
 
 avr-size --format=avr --mcu=atmega328p "$elf" | grep -E "^(Program|Data):" | sed 's/^/   /'
