@@ -347,22 +347,22 @@ uint32_t diff_um(const Num& a, const Num& b) {
     return x > y ? x - y : y - x;
 }
 
-// Distance (um, approximate: |F| / |grad F| with F = (x/p)^2 + (y/q)^2 - 1) from (x, y) to the
-// ellipse of semi-axes p, q centred on the origin.
-uint32_t ellipse_gap_um(int32_t x, int32_t y, uint32_t p, uint32_t q) {
-    Num a(abs32(x)), b(abs32(y));
-    a.div(p);
-    b.div(q);
-    Num aa = a, bb = b;
-    Num f = aa.mul(a).add(bb.mul(b));   // (x/p)^2 + (y/q)^2
-    uint32_t f_q30 = f.shift(30).u32(); // saturates far from the curve
-    uint32_t off = f_q30 > (1ul << 30) ? f_q30 - (1ul << 30) : (1ul << 30) - f_q30;
-    Num gx = a, gy = b;
-    gx.div(p);
-    gy.div(q);
-    Num g = gx.mul(gx).add(gy.mul(gy)).sqrt().shift(1); // |grad F|, per um
-    if (g.m == 0) return 0xFFFFFFFFul;
-    return Num(off).shift(-30).div(g).u32();
+// How far (um, the larger of the two coordinates) (x, y) is from the point of the ellipse of
+// semi-axes `radii` centred on the origin that has the same direction in the ellipse's own scale
+// (ellipse_direction): within a tick of it is on the ellipse. (A point so far out that the
+// difference wraps is refused by the range check anyway.)
+uint32_t ellipse_gap_um(int32_t x, int32_t y, const uint32_t radii[2]) {
+    int32_t cs[2];
+    ellipse_direction(x, y, radii, cs[0], cs[1]);
+    const int32_t xy[2] = {x, y};
+    uint32_t gap = 0;
+    for (uint8_t k = 0; k < 2; ++k) {
+        uint32_t on = Num(radii[k]).mul(abs32(cs[k])).shift(-30).u32();
+        uint32_t d = static_cast<uint32_t>(xy[k]) - (cs[k] < 0 ? 0u - on : on);
+        d = abs32(static_cast<int32_t>(d));
+        if (d > gap) gap = d;
+    }
+    return gap;
 }
 
 // A length word of the block (um), or `dflt` when absent; false on overflow.
@@ -430,15 +430,15 @@ uint8_t check_curve(Block& b, Motion motion, uint8_t axes, const State& st, Curv
         c.a_um[1] = add(c.start_um[1], ov);
         c.b_um[0] = pw;
         c.b_um[1] = qw;
-        uint32_t tick = 0;
+        const uint32_t radii[2] = {static_cast<uint32_t>(pw), static_cast<uint32_t>(qw)};
+        uint32_t tol = 0;
         for (uint8_t k = 0; k < 2; ++k) {
-            uint32_t t = 1000000ul / g_settings.axis[ax[k]].steps_per_unit; // um per step
-            if (t > tick) tick = t;
+            uint32_t t = 1000000ul / g_settings.axis[ax[k]].steps_per_unit + 2; // a step + 2 um
+            if (t > tol) tol = t;
         }
-        uint32_t tol = tick + 2;
-        if (ellipse_gap_um(-ou, -ov, static_cast<uint32_t>(pw), static_cast<uint32_t>(qw)) > tol ||
+        if (ellipse_gap_um(-ou, -ov, radii) > tol ||
             ellipse_gap_um(add(c.end_um[0], c.a_um[0], true), add(c.end_um[1], c.a_um[1], true),
-                           static_cast<uint32_t>(pw), static_cast<uint32_t>(qw)) > tol) {
+                           radii) > tol) {
             return kInvalidTarget;
         }
     } else {

@@ -161,6 +161,19 @@ TEST_F(Curves, BadArcsGetGrblsErrorCodes) {
     EXPECT_EQ(p.back().p[1], 0);
 }
 
+// The ends of an ellipse must be on it within a step (12.5 um here) + 2 um, as an arc's within
+// GRBL's tolerance. Checked in check mode ($C): nothing moves.
+TEST_F(Curves, EllipseEndsMustLieOnTheEllipseWithinAStep) {
+    ASSERT_EQ(run("$C"), "[MSG:Enabled]\r\nok\r\n");
+    EXPECT_EQ(run("G2.1 X10.014 I5 J0 P5 Q3 F600"), "ok\r\n");
+    EXPECT_EQ(run("G0 X0 Y0"), "ok\r\n");
+    EXPECT_EQ(run("G2.1 X10.015 I5 J0 P5 Q3 F600"), "error:33\r\n");
+    EXPECT_EQ(run("G2.1 X5 Y3.014 I5 J0 P5 Q3 F600"), "ok\r\n");
+    EXPECT_EQ(run("G0 X0 Y0"), "ok\r\n");
+    EXPECT_EQ(run("G2.1 X5 Y2.985 I5 J0 P5 Q3 F600"), "error:33\r\n");
+    EXPECT_EQ(run("G2.1 X10 I5.015 J0 P5 Q3 F600"), "error:33\r\n"); // the start is off
+}
+
 // Radius mode: the centre is on the chord's bisector, on the right of the way for G2 with R > 0,
 // on the left for G3 or R < 0 (the longer arc).
 TEST_F(Curves, RadiusModePicksTheCentreAsGrblDoes) {
