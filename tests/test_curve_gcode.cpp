@@ -241,6 +241,36 @@ TEST_F(Curves, FullCircleIsOneMoveAtTheFeedWithinThreeQuartersOfAStep) {
     EXPECT_GT(p[100].p[1], 0);
 }
 
+// G18 (Z, X) and G19 (Y, Z) as GRBL orders their axes: the centre offsets are K I and J K, and
+// G2 turns clockwise in (first axis, second axis), so from the circle's low point on the first
+// axis it heads along +second axis.
+TEST_F(Curves, ArcsInG18AndG19UseTheirPlanesAxesAndSense) {
+    struct Case {
+        const char* line;
+        int u, v; ///< the plane's axes (0 X, 1 Y, 2 Z)
+    } cases[] = {
+        {"G18 G2 X0 Z0 K10 I0 F3000", 2, 0},
+        {"G19 G2 Y0 Z0 J10 K0 F3000", 1, 2},
+        {"G17 G2 X0 Y0 I10 J0 F3000", 0, 1},
+    };
+    for (const auto& c : cases) {
+        size_t from = ll::host::edges().size();
+        ASSERT_EQ(run(c.line), "ok\r\n") << c.line;
+        d.run_until_idle();
+        auto p = path(from);
+        ASSERT_GT(p.size(), 100u) << c.line;
+        double worst = 0;
+        for (const auto& s : p) {
+            worst = std::max(worst, std::fabs(std::hypot(s.p[c.u] - 800.0, s.p[c.v]) - 800.0));
+            EXPECT_EQ(s.p[3 - c.u - c.v], 0) << c.line; // the third axis stays put
+        }
+        EXPECT_LT(worst, 0.75) << c.line;
+        EXPECT_GT(p[50].p[c.v], 0) << c.line;
+        EXPECT_EQ(p.back().p[c.u], 0) << c.line;
+        EXPECT_EQ(p.back().p[c.v], 0) << c.line;
+    }
+}
+
 // P counts turns (LinuxCNC): P2 adds one full circle to the arc.
 TEST_F(Curves, ArcTurnsWordAddsFullCircles) {
     ASSERT_EQ(run("G3 X10 I5 P2 F3000"), "ok\r\n");
