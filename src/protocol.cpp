@@ -214,7 +214,8 @@ __attribute__((noinline)) uint8_t system_command() {
             out::u8(kPlannerSize); // the ring holds kPlannerSize moves
             out::ch(',');
             out::u8(p.rx_capacity);
-            out::line(LL_PSTR("]"));
+            // The curve extensions (docs/curves.md), as a message senders show as it is.
+            out::line(LL_PSTR("]\r\n[MSG:G2.1/G3.1 ellipse IJ=centre PQ=semi-axes, G5 Bezier]"));
         }
         return kOk;
     }

@@ -124,7 +124,8 @@ TEST_F(Protocol, StatusReportInInchesAndWorkPosition) {
 
 TEST_F(Protocol, BuildInfoNamesTheProject) {
     EXPECT_EQ(d.command("$I"),
-              "[VER:1.1h.20250101:Low Level " LL_VERSION_STRING "]\r\n[OPT:I,16,128]\r\nok\r\n");
+              "[VER:1.1h.20250101:Low Level " LL_VERSION_STRING "]\r\n[OPT:I,16,128]\r\n"
+              "[MSG:G2.1/G3.1 ellipse IJ=centre PQ=semi-axes, G5 Bezier]\r\nok\r\n");
 }
 
 TEST_F(Protocol, HelpParserStateAndOffsets) {
