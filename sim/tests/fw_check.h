@@ -159,6 +159,5 @@ char axis_name(uint8_t axis);
 #define REQUIRE_FIRMWARE()                                                                         \
     ASSERT_TRUE(::ll::sim::fw::firmware_exists())                                                  \
         << "missing " << ::ll::sim::fw::firmware_elf()                                             \
-        << ": build the firmware first (cmake --preset avr -DLL_FLASH_BUDGET=32256 "               \
-           "-DLL_RAM_BUDGET=2048 && cmake --build --preset avr), or point LL_FIRMWARE_DIR at "     \
-           "the directory holding lowlevel.elf"
+        << ": build the firmware first (cmake --preset avr && cmake --build --preset avr), or "    \
+           "point LL_FIRMWARE_DIR at the directory holding lowlevel.elf"
