@@ -55,7 +55,7 @@ void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[k
     e[0] = len;
     const uint32_t mask = (1ul << g.shift) - 1;
     if (c.x1 == g.dist[0]) {
-        // Last segment: S_j * d_1 + P/2 lands within 1/8 tick of d_j + 1/2 by construction
+        // Last segment: S_j * d_1 + P/2 lands within 1/16 tick of d_j + 1/2 by construction
         // (|d_1 (S_j / P - s_j)| <= d_1 / (2P) <= 1/16), so the formula gives d_j exactly;
         // writing it directly also saves the multiplication.
         for (uint8_t j = 1; j < g.m; ++j) {

@@ -47,6 +47,7 @@ bool StepGen::begin(const MoveSpec& spec) {
     v_exit2_ = spec.v_exit2;
     line_start(ln_.g, ln_.c);
     build_k_table(spec.group);
+    ln_.k_err = 0;
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
@@ -366,7 +367,10 @@ uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest) {
 void StepGen::finish_move() {
     active_ = false;
     have_handover_ = true;
-    handover_v2_ = holding_ ? speed2() : v_exit2_;
+    // The speed reached, which is below the planned exit when a raised exit came too late for
+    // a short move to accelerate to it (the next move must start from what was reached).
+    uint32_t reached = speed2();
+    handover_v2_ = holding_ || reached < v_exit2_ ? reached : v_exit2_;
 }
 
 void StepGen::fill_line(RunQueue& q) {
@@ -383,10 +387,37 @@ void StepGen::fill_line(RunQueue& q) {
         line_advance(ln_.g, ln_.c, len, e);
         MicroRun runs[kAxes];
         uint8_t n = micro_split(e, ln_.g.m, runs);
+        // The K table makes the micro steps of a segment last len x Delta_1 altogether when they
+        // are nested as in §8 (docs/motion.md, "Feed along the line"). A segment whose micro
+        // steps are not (a single tick at low speed, where the minor axes of a 3- or 4-axis line
+        // step on ticks of their own) sums to more or less. The difference is carried over and
+        // beyond a dead band of half a tick (within which the nested segments of 2-axis lines
+        // stay, and end exact) it scales the next segment's Delta_1, spread over its ticks: the
+        // waits keep the §3.2 proportions at a speed corrected per segment, and the feed along
+        // the whole line stays exact within about half a tick's time.
+        uint8_t sh = 0; // spread over the segment length in force (not a short last one)
+        while ((2u << sh) <= seg_len_) ++sh;
+        const int32_t band = 1l << 19;
+        int32_t over = ln_.k_err > band ? ln_.k_err - band : 0;
+        if (ln_.k_err < -band) over = ln_.k_err + band;
+        // Per tick, Q20 of the mean K (1.0): the next ticks last (1 - corr) as long.
+        int32_t corr = over >> sh;              // arithmetic shift
+        if (corr > (1l << 18)) corr = 1l << 18; // at most a quarter: no jolt
+        if (corr < -(1l << 18)) corr = -(1l << 18);
+        uint32_t d = delta;
+        if (corr > 0) d -= mul_shr(delta, static_cast<uint32_t>(corr), 20);
+        if (corr < 0) d += mul_shr(delta, static_cast<uint32_t>(-corr), 20);
+        uint32_t sum = 0;
         for (uint8_t i = 0; i < n; ++i) {
             uint8_t idx = static_cast<uint8_t>(runs[i].set >> 1);
-            emit(q, ln_.mask[idx], ln_.g.dirs, runs[i].count, mul_shr(delta, ln_.k[idx], 20));
+            sum += runs[i].count * ln_.k[idx];
+            emit(q, ln_.mask[idx], ln_.g.dirs, runs[i].count, mul_shr(d, ln_.k[idx], 20));
         }
+        // What this segment took, in K units of the uncorrected Delta_1: sum x (1 - corr).
+        int32_t took = static_cast<int32_t>(sum);
+        if (corr > 0) took -= static_cast<int32_t>(mul_shr(sum, static_cast<uint32_t>(corr), 20));
+        if (corr < 0) took += static_cast<int32_t>(mul_shr(sum, static_cast<uint32_t>(-corr), 20));
+        ln_.k_err += took - (static_cast<int32_t>(len) << 20);
 #if LL_STATS
         ++stats.segments;
 #endif

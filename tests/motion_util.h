@@ -86,4 +86,34 @@ inline std::vector<Event> run_move(ll::StepGen& gen, const ll::MoveSpec& spec,
     return out;
 }
 
+/// Runs the whole move one macro segment at a time and returns each segment's runs: before each
+/// fill the queue is padded so that it has room for exactly one segment of an m-axis line (the
+/// generator wants 2 m free slots), so each fill produces one. Lines only.
+inline std::vector<std::vector<ll::Run>> run_segments(ll::StepGen& gen, const ll::MoveSpec& spec) {
+    std::vector<std::vector<ll::Run>> out;
+    uint8_t m = 0;
+    for (uint8_t a = 0; a < ll::kAxes; ++a) m = static_cast<uint8_t>(m + (spec.delta[a] != 0));
+    ll::RunQueue q;
+    q.clear();
+    if (!gen.begin(spec)) return out;
+    while (gen.active()) {
+        uint8_t pad = 0;
+        while (q.free_slots() > 2 * m) {
+            q.push(ll::Run{0, 0, 1, 1});
+            ++pad;
+        }
+        gen.clear_queue_time();
+        gen.fill(q);
+        for (; pad > 0; --pad) q.pop();
+        std::vector<ll::Run> seg;
+        while (!q.empty()) {
+            seg.push_back(q.front());
+            q.pop();
+        }
+        if (seg.empty()) break;
+        out.push_back(seg);
+    }
+    return out;
+}
+
 } // namespace lltest

@@ -159,3 +159,30 @@ TEST_F(MotionTest, DriversAreEnabledWhileMovingAndReleasedAfterTheIdleDelay) {
     EXPECT_EQ(ll::host::edges().back().level, 1);
     EXPECT_GE(ll::host::edges().back().cycle - stop, 16000ull * 25);
 }
+
+TEST_F(MotionTest, LookAheadArrivingLateNeverMakesTheSpeedJump) {
+    // X10 and X10.5 queued together: the short second move is planned to stop. X20.5 arrives
+    // 0.215 s later, while the first move already slows down for it: the second move's exit is
+    // raised but it is too short to reach that speed, so the third must start from the speed
+    // actually reached, not the planned one (which jumped from 3518 to 4000 steps/s in one step).
+    // Over any 8 steps the squared step rate may grow by 2 a x 8 (a = 80,000 steps/s^2), with
+    // room for the square-root tracker's quantisation (single steps reach 1.75 x 2 a).
+    lltest::line_to({10, 0, 0, 0}, 3000);
+    lltest::line_to({10.5, 0, 0, 0}, 3000);
+    lltest::run_for(static_cast<uint64_t>(0.215 * 16e6));
+    lltest::line_to({20.5, 0, 0, 0}, 3000);
+    ASSERT_TRUE(lltest::run_until(State::Idle));
+    std::vector<uint64_t> t;
+    for (const auto& e : ll::host::edges()) {
+        if (e.kind == ll::host::EdgeKind::Step && e.level == 1 && e.axis == 0) t.push_back(e.cycle);
+    }
+    ASSERT_EQ(t.size(), 1640u);
+    auto rate = [&](size_t k) { return 16e6 / static_cast<double>(t[k] - t[k - 1]); };
+    double worst = 0;
+    for (size_t k = 1; k + 8 < t.size(); ++k) {
+        double r0 = rate(k), r1 = rate(k + 8);
+        worst = std::max(worst, (r1 * r1 - r0 * r0) / (2 * 80000.0 * 8));
+    }
+    std::printf("largest squared-rate gain over 8 steps: %.2f x 2a\n", worst);
+    EXPECT_LE(worst, 1.3);
+}

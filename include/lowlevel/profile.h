@@ -15,7 +15,8 @@
 // move, then cruises, and only decelerates at the end; the deceleration point and, when the
 // cruise speed cannot be reached, the peak come from the closed form
 //   A_peak = (A_entry + A_exit + s d) / 2      (v_p^2 = (v_0^2 + v_1^2) / 2 + a L)
-//   x_decel = (A_exit - A_entry + s d) / (2 s)
+//   x_meet = (A_exit - A_entry + s d) / (2 s)   (where the two meet: the deceleration point when
+//                                             the cruise speed is out of reach)
 #pragma once
 
 #include <stdint.h>

@@ -120,7 +120,7 @@ class StepGen {
         return prof_;
     }
     /// K table: normalised wait-time factor of each axis set containing the reference axis,
-    /// indexed by (sorted-position set >> 1), Q16. Delta_P = K[P] * Delta_1 >> 16.
+    /// indexed by (sorted-position set >> 1), Q20. Delta_P = K[P] * Delta_1 >> 20.
     uint32_t k(uint8_t index) const {
         return ln_.k[index];
     }
@@ -180,7 +180,8 @@ class StepGen {
     struct LineState {
         LineGeometry g;
         LineCursor c;
-        uint32_t kmax;                   ///< largest K of the move
+        uint32_t kmax; ///< largest K of the move
+        int32_t k_err; ///< K-time emitted beyond len x Delta_1 so far, Q20 (see fill_line)
         uint32_t k[1u << (kAxes - 1)];   ///< K table, Q20 (see k())
         uint8_t mask[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
     };
