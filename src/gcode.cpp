@@ -374,9 +374,48 @@ bool word_um(const Block& b, uint8_t word, int32_t dflt, int32_t& out) {
     return length(b, b.v[word].d, out);
 }
 
+// The step generator's fixed-point range (docs/curves.md): the ends, the control points or the
+// centre, and the semi-axes, within 2^22 steps; the length within 2^23 um (an arc's is at most
+// its larger semi-axis times its sweep; a Bezier's at most its control polygon's), and the
+// normal axis' travel `dw_um` too. (A function of its own: a small stack frame.)
+__attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_t ax[3],
+                                              int32_t dw_um) {
+    uint32_t reach = 0; // length bound, um / 2
+    for (uint8_t k = 0; k < 2; ++k) {
+        const int32_t pts[4] = {c.start_um[k], c.end_um[k], c.a_um[k], c.b_um[k]};
+        for (int32_t p : pts) {
+            int32_t steps;
+            if (!num::mul_div_round(p, g_settings.axis[ax[k]].steps_per_unit, 1000000u, steps) ||
+                abs32(steps) > (1l << 22)) {
+                return false;
+            }
+        }
+        if (c.kind == kCurveBezier) {
+            reach += abs32(c.a_um[k] - c.start_um[k]) / 2 + abs32(c.b_um[k] - c.a_um[k]) / 2 +
+                     abs32(c.end_um[k] - c.b_um[k]) / 2;
+        }
+    }
+    if (c.kind == kCurveArc) {
+        const uint32_t radii[2] = {static_cast<uint32_t>(c.b_um[0]),
+                                   static_cast<uint32_t>(c.b_um[1])};
+        int32_t c0, s0, c1, s1;
+        ellipse_direction(c.start_um[0] - c.a_um[0], c.start_um[1] - c.a_um[1], radii, c0, s0);
+        ellipse_direction(c.end_um[0] - c.a_um[0], c.end_um[1] - c.a_um[1], radii, c1, s1);
+        int64_t sweep = arc_sweep_q29(c0, s0, c1, s1, c.clockwise != 0, c.turns);
+        uint64_t mag = static_cast<uint64_t>(sweep < 0 ? -sweep : sweep);
+        uint32_t r = radii[0] > radii[1] ? radii[0] : radii[1];
+        // r |sweep| / 2, |sweep| < 2^40 (Q29, 256 turns), r < 2^31.
+        uint64_t half = (static_cast<uint64_t>(r) * (mag >> 14)) >> 16;
+        reach = half > 0xFFFFFFFFull ? 0xFFFFFFFFul : static_cast<uint32_t>(half);
+    }
+    reach += abs32(dw_um) / 2;
+    return reach < (1ul << 22);
+}
+
 // Stage 3 of a curve (docs/curves.md): the checks and errors of GRBL's arcs (26 32 33 34 35), our
 // extensions' (ellipses, G5), and the geometry handed to the planner. Consumes its words.
-uint8_t check_curve(Block& b, Motion motion, uint8_t axes, const State& st, CurveParams& c) {
+__attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t axes,
+                                              const State& st, CurveParams& c) {
     uint8_t ax[3];
     c.plane = b.g[kGroupPlane];
     plane_axes(c.plane, ax);
@@ -493,40 +532,9 @@ uint8_t check_curve(Block& b, Motion motion, uint8_t axes, const State& st, Curv
             c.turns = static_cast<uint8_t>(turns - 1);
         }
     }
-    // The step generator's fixed-point range (docs/curves.md), else error:33: the ends, the
-    // control points or the centre, and the semi-axes, within 2^22 steps; the length within
-    // 2^23 um (an arc's is at most its larger semi-axis times its sweep; a Bezier's at most its
-    // control polygon's), and the normal axis' travel too.
-    uint32_t reach = 0; // length bound, um / 2
-    for (uint8_t k = 0; k < 2; ++k) {
-        const int32_t pts[4] = {c.start_um[k], c.end_um[k], c.a_um[k], c.b_um[k]};
-        for (int32_t p : pts) {
-            int32_t steps;
-            if (!num::mul_div_round(p, g_settings.axis[ax[k]].steps_per_unit, 1000000u, steps) ||
-                abs32(steps) > (1l << 22)) {
-                return kInvalidTarget;
-            }
-        }
-        if (c.kind == kCurveBezier) {
-            reach += abs32(c.a_um[k] - c.start_um[k]) / 2 + abs32(c.b_um[k] - c.a_um[k]) / 2 +
-                     abs32(c.end_um[k] - c.b_um[k]) / 2;
-        }
+    if (!curve_in_range(c, ax, add(w.req.target_um[ax[2]], st.position[ax[2]], true))) {
+        return kInvalidTarget;
     }
-    if (c.kind == kCurveArc) {
-        const uint32_t radii[2] = {static_cast<uint32_t>(c.b_um[0]),
-                                   static_cast<uint32_t>(c.b_um[1])};
-        int32_t c0, s0, c1, s1;
-        ellipse_direction(c.start_um[0] - c.a_um[0], c.start_um[1] - c.a_um[1], radii, c0, s0);
-        ellipse_direction(c.end_um[0] - c.a_um[0], c.end_um[1] - c.a_um[1], radii, c1, s1);
-        int64_t sweep = arc_sweep_q29(c0, s0, c1, s1, c.clockwise != 0, c.turns);
-        uint64_t mag = static_cast<uint64_t>(sweep < 0 ? -sweep : sweep);
-        uint32_t r = radii[0] > radii[1] ? radii[0] : radii[1];
-        // r |sweep| / 2, |sweep| < 2^40 (Q29, 256 turns), r < 2^31.
-        uint64_t half = (static_cast<uint64_t>(r) * (mag >> 14)) >> 16;
-        reach = half > 0xFFFFFFFFull ? 0xFFFFFFFFul : static_cast<uint32_t>(half);
-    }
-    reach += abs32(w.req.target_um[ax[2]] - st.position[ax[2]]) / 2;
-    if (reach >= (1ul << 22)) return kInvalidTarget;
     if (b.overflow) return kInvalidTarget;
     b.words = static_cast<WordMask>(b.words & ~used);
     return kOk;
