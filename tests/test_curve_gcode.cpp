@@ -12,6 +12,7 @@
 
 #include "host_driver.h"
 #include "host_hal.h"
+#include "path_check.h"
 
 namespace {
 
@@ -65,31 +66,16 @@ struct Curves : ::testing::Test {
         return out;
     }
 
-    // Largest distance (steps) from the visited positions to the curve `f` sampled densely in
-    // the plane (X, Y): the nearest of 200000 points of the curve for each position.
+    // Largest distance (steps) from the visited positions to the plane curve c(u), u in [0, 1].
     template <class F>
-    static double worst_distance(const std::vector<Sample>& p, F f) {
-        const int n = 200000;
-        std::vector<std::pair<double, double>> pts(n + 1);
-        for (int i = 0; i <= n; ++i) pts[i] = f(static_cast<double>(i) / n);
-        double worst = 0;
-        size_t hint = 0;
-        for (const auto& s : p) {
-            double best = 1e30;
-            // The path advances along the curve: search around the last match first, then widely.
-            for (size_t k = 0; k < pts.size(); ++k) {
-                size_t i = (hint + k) % pts.size();
-                double dx = s.p[0] - pts[i].first, dy = s.p[1] - pts[i].second;
-                double dd = dx * dx + dy * dy;
-                if (dd < best) {
-                    best = dd;
-                    hint = i;
-                }
-                if (k > 4000 && best < 1.0) break;
-            }
-            worst = std::max(worst, std::sqrt(best));
-        }
-        return worst;
+    static double worst_distance(const std::vector<Sample>& p, F c) {
+        std::vector<lltest::PlanePoint> pts;
+        for (const auto& s : p)
+            pts.push_back({static_cast<double>(s.p[0]), static_cast<double>(s.p[1])});
+        return lltest::worst_distance(pts, [&](double u) {
+            auto q = c(u);
+            return lltest::PlanePoint{q.first, q.second};
+        });
     }
 
     // Lowest speed along the path in the middle of the job, mm/min: the distance between
@@ -110,16 +96,9 @@ struct Curves : ::testing::Test {
     // and 70 % of the steps, mm/min: the swept angle (unwrapped) times r over the time.
     static double circle_speed(const std::vector<Sample>& p, double cx, double cy, double r) {
         size_t a = p.size() * 3 / 10, b = p.size() * 7 / 10;
+        lltest::AngleTracker ang(cx * kStepsPerMm, cy * kStepsPerMm, p[a].p[0], p[a].p[1]);
         double swept = 0;
-        double prev = std::atan2(p[a].p[1] / kStepsPerMm - cy, p[a].p[0] / kStepsPerMm - cx);
-        for (size_t i = a + 1; i <= b; ++i) {
-            double t = std::atan2(p[i].p[1] / kStepsPerMm - cy, p[i].p[0] / kStepsPerMm - cx);
-            double dt = t - prev;
-            while (dt > kPi) dt -= 2 * kPi;
-            while (dt < -kPi) dt += 2 * kPi;
-            swept += dt;
-            prev = t;
-        }
+        for (size_t i = a + 1; i <= b; ++i) swept = ang.add(p[i].p[0], p[i].p[1]);
         return std::fabs(swept) * r / (static_cast<double>(p[b].cycle - p[a].cycle) / kF) * 60;
     }
 };
@@ -194,15 +173,12 @@ TEST_F(Curves, RadiusModePicksTheCentreAsGrblDoes) {
         auto p = path(from);
         ASSERT_FALSE(p.empty()) << c.line;
         double r = std::hypot(c.cx, c.cy) * kStepsPerMm;
-        double worst = 0, swept = 0, prev = std::atan2(-c.cy, -c.cx);
+        double worst = 0, swept = 0;
+        lltest::AngleTracker ang(c.cx * kStepsPerMm, c.cy * kStepsPerMm, 0, 0);
         for (const auto& s : p) {
             double x = s.p[0] - c.cx * kStepsPerMm, y = s.p[1] - c.cy * kStepsPerMm;
             worst = std::max(worst, std::fabs(std::hypot(x, y) - r));
-            double t = std::atan2(y, x), dt = t - prev;
-            while (dt > kPi) dt -= 2 * kPi;
-            while (dt < -kPi) dt += 2 * kPi;
-            swept += dt;
-            prev = t;
+            swept = ang.add(s.p[0], s.p[1]);
         }
         EXPECT_LT(worst, 0.75) << c.line;
         EXPECT_NEAR(swept / (2 * kPi), c.sweep, 0.01) << c.line;
@@ -291,13 +267,10 @@ TEST_F(Curves, HelixRaisesTheNormalAxisWithTheAngleAtThePathFeed) {
     auto p = path();
     ASSERT_FALSE(p.empty());
     EXPECT_EQ(p.back().p[2], 400);
-    double worst = 0, swept = 0, prev = kPi;
+    double worst = 0;
+    lltest::AngleTracker ang(800, 0, 0, 0);
     for (const auto& s : p) {
-        double t = std::atan2(s.p[1], s.p[0] - 800.0), dt = t - prev;
-        while (dt > kPi) dt -= 2 * kPi;
-        while (dt < -kPi) dt += 2 * kPi;
-        swept += dt;
-        prev = t;
+        double swept = ang.add(s.p[0], s.p[1]);
         worst = std::max(worst, std::fabs(s.p[2] - 400 * (-swept) / (2 * kPi)));
     }
     EXPECT_LT(worst, 1.0);

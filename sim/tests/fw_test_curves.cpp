@@ -10,6 +10,7 @@
 #include <functional>
 
 #include "fw_check.h"
+#include "path_check.h"
 
 using namespace ll::sim;
 using namespace ll::sim::fw;
@@ -18,9 +19,7 @@ namespace {
 
 const double kPi = acos(-1.0);
 
-struct Point {
-    double x, y;
-};
+using Point = lltest::PlanePoint;
 
 // The positions (X, Y steps) the step pins visit, X and Y edges of the same cycle (one port
 // write) taken together.
@@ -47,30 +46,6 @@ std::vector<Point> visited(const Trace& t) {
     return out;
 }
 
-// Largest distance from the visited positions to the curve c(u), u in [0, 1], sampled at 2e5
-// points (a local search that follows the path, with a full scan when it loses it).
-double worst_distance(const std::vector<Point>& pts, const std::function<Point(double)>& c) {
-    const size_t n = 200000;
-    std::vector<Point> curve(n + 1);
-    for (size_t i = 0; i <= n; ++i) curve[i] = c(static_cast<double>(i) / n);
-    double worst = 0;
-    size_t hint = 0;
-    for (const Point& p : pts) {
-        double best = 1e30;
-        for (size_t k = 0; k < curve.size(); ++k) {
-            size_t i = (hint + k) % curve.size();
-            double d = hypot(p.x - curve[i].x, p.y - curve[i].y);
-            if (d < best) {
-                best = d;
-                hint = i;
-            }
-            if (k > 4000 && best < 1.0) break;
-        }
-        worst = std::max(worst, best);
-    }
-    return worst;
-}
-
 const std::vector<std::string> kSettings = {"$100=80",   "$101=80",   "$110=6000",
                                             "$111=6000", "$120=1000", "$121=1000"};
 
@@ -84,7 +59,7 @@ void check_curve(const std::string& line, const std::function<Point(double)>& cu
     ASSERT_TRUE(chip.errors.empty()) << chip.errors.front();
     const std::vector<Point> pts = visited(chip);
     ASSERT_GT(pts.size(), 100u);
-    const double worst = worst_distance(pts, curve);
+    const double worst = lltest::worst_distance(pts, curve);
     printf("[ measured ] %s: %zu positions, worst distance %.3f step, end (%g, %g), "
            "%.3f s, starvations %u\n",
            line.c_str(), pts.size(), worst, pts.back().x, pts.back().y,
