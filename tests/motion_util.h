@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "lowlevel/stepgen.h"
@@ -16,6 +17,25 @@ struct Event {
     uint8_t dirs;
     uint16_t period;
 };
+
+/// A random line: 1 to 4 moving axes (possibly the same one twice), the longest with a
+/// log-uniform length of 1 to 100,000 ticks, the others up to it, random directions.
+template <class Rng>
+void random_delta(Rng& rng, int32_t delta[ll::kAxes]) {
+    std::uniform_real_distribution<double> logd(0.0, std::log(100000.0));
+    for (uint8_t a = 0; a < ll::kAxes; ++a) delta[a] = 0;
+    uint8_t axes = static_cast<uint8_t>(1 + rng() % 4);
+    int32_t longest = static_cast<int32_t>(std::lround(std::exp(logd(rng))));
+    if (longest < 1) longest = 1;
+    for (uint8_t k = 0; k < axes; ++k) {
+        uint8_t a = static_cast<uint8_t>(rng() % ll::kAxes);
+        int32_t d = k == 0 ? longest : static_cast<int32_t>(rng() % (longest + 1));
+        delta[a] = (rng() & 1) ? -d : d;
+    }
+    bool any = false;
+    for (uint8_t a = 0; a < ll::kAxes; ++a) any = any || delta[a] != 0;
+    if (!any) delta[0] = 1;
+}
 
 /// Machine description for a test: steps per mm of each axis.
 struct Machine {

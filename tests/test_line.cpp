@@ -101,21 +101,12 @@ TEST(Line, ZeroAndOverlongLinesAreRefused) {
 
 TEST(Line, TenThousandRandomLinesEndExactlyMoveByUnitStepsAndStayWithinTheBound) {
     std::mt19937 rng(20261121);
-    std::uniform_real_distribution<double> logd(0.0, std::log(100000.0));
     double worst_excess = -1e9;
     double worst_dev_l1 = 0;
     uint64_t steps = 0;
     for (int i = 0; i < 10000; ++i) {
-        int32_t delta[ll::kAxes] = {};
-        uint8_t axes = static_cast<uint8_t>(1 + rng() % 4);
-        int32_t longest = static_cast<int32_t>(std::lround(std::exp(logd(rng))));
-        if (longest < 1) longest = 1;
-        for (uint8_t k = 0; k < axes; ++k) {
-            uint8_t a = static_cast<uint8_t>(rng() % ll::kAxes);
-            int32_t d = k == 0 ? longest : static_cast<int32_t>(rng() % (longest + 1));
-            delta[a] = (rng() & 1) ? -d : d;
-        }
-        if (delta[0] == 0 && delta[1] == 0 && delta[2] == 0 && delta[3] == 0) delta[0] = 1;
+        int32_t delta[ll::kAxes];
+        lltest::random_delta(rng, delta);
         // Alternate between the fine regime (L = 1) and random segment lengths up to 16.
         std::vector<uint8_t> lens;
         if (i % 2 == 0) {

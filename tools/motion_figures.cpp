@@ -82,20 +82,6 @@ void walk(const int32_t delta[ll::kAxes], uint8_t len, Dev& d,
     }
 }
 
-void random_delta(std::mt19937& rng, int32_t delta[ll::kAxes]) {
-    std::uniform_real_distribution<double> logd(0.0, std::log(100000.0));
-    for (uint8_t a = 0; a < ll::kAxes; ++a) delta[a] = 0;
-    uint8_t axes = static_cast<uint8_t>(1 + rng() % 4);
-    int32_t longest = static_cast<int32_t>(std::lround(std::exp(logd(rng))));
-    if (longest < 1) longest = 1;
-    for (uint8_t k = 0; k < axes; ++k) {
-        uint8_t a = static_cast<uint8_t>(rng() % ll::kAxes);
-        int32_t d = k == 0 ? longest : static_cast<int32_t>(rng() % (longest + 1));
-        delta[a] = (rng() & 1) ? -d : d;
-    }
-    if (delta[0] == 0 && delta[1] == 0 && delta[2] == 0 && delta[3] == 0) delta[0] = 1;
-}
-
 void section_line() {
     std::printf("## Line positions (seed §7.2)\n\n");
     int32_t ex[ll::kAxes] = {1000, 500, 490, 0};
@@ -119,7 +105,7 @@ void section_line() {
         Dev d;
         for (int i = 0; i < 2000; ++i) {
             int32_t delta[ll::kAxes];
-            random_delta(rng, delta);
+            lltest::random_delta(rng, delta);
             walk(delta, len, d);
         }
         std::printf("| %u | %llu | %.4f | %.4f | %.4f | %+.4f |\n", len,
