@@ -14,46 +14,73 @@ uint32_t axis_limit(const Settings& s, uint8_t a, Limit which) {
     return which == kRate ? s.axis[a].max_rate : s.axis[a].accel;
 }
 
-// min over axes with comp[a] > 0 of lim[a] / comp[a], times `scale`: the largest value along a
-// direction that keeps every axis within its own limit (GRBL's limit_value_by_axis_maximum).
-uint32_t limit_along(const Settings& s, Limit which, const uint32_t comp[kAxes], Num scale) {
-    Num best{};
-    bool any = false;
+// Normalised constants for Num::mulc().
+constexpr uint32_t k3_6 = 0xE6666666ul; // 3.6 = k3_6 * 2^-30: units/s^2 x1000 -> units/min^2
+constexpr int8_t k3_6e = -30;
+constexpr uint32_t kMilli = 0x83126E97ul; // 1/1000 = kMilli * 2^-41 (1/128000: 2^-48)
+constexpr uint32_t kMicro = 0x8637BD05ul; // 1e-6 = kMicro * 2^-51 (5e-7: 2^-52)
+
+// n1 / d1 < n2 / d2, exactly (64-bit products).
+bool ratio_less(uint32_t n1, uint32_t d1, uint32_t n2, uint32_t d2) {
+    if (n1 == n2) return d1 > d2;
+    uint32_t l1, h1 = mul_wide(n1, d2, l1);
+    uint32_t l2, h2 = mul_wide(n2, d1, l2);
+    return h1 != h2 ? h1 < h2 : l1 < l2;
+}
+
+// The axis with comp[a] > 0 whose lim[a] / comp[a] is the smallest (the first one on a tie),
+// kAxes when every comp[a] is 0.
+uint8_t tightest(const Settings& s, Limit which, const uint32_t comp[kAxes]) {
+    uint8_t best = kAxes;
     for (uint8_t a = 0; a < kAxes; ++a) {
         if (comp[a] == 0) continue;
-        Num v(axis_limit(s, a, which));
-        v.div(comp[a]);
-        if (!any || v.cmp(best) < 0) best = v;
-        any = true;
+        if (best == kAxes ||
+            ratio_less(axis_limit(s, a, which), comp[a], axis_limit(s, best, which), comp[best])) {
+            best = a;
+        }
     }
-    if (!any) return 0xFFFFFFFFul;
-    if (which == kAccel) scale.mul(Num(18)).div(5); // units/s^2 x1000 -> units/min^2
+    return best;
+}
+
+// min over axes with comp[a] > 0 of lim[a] / comp[a], times `scale`: the largest value along a
+// direction that keeps every axis within its own limit (GRBL's limit_value_by_axis_maximum).
+// The bounding axis is found by exact comparisons, so there is one division.
+uint32_t limit_along(const Settings& s, Limit which, const uint32_t comp[kAxes], Num scale) {
+    uint8_t a = tightest(s, which, comp);
+    if (a == kAxes) return 0xFFFFFFFFul;
+    Num best(axis_limit(s, a, which));
+    best.div(comp[a]);
+    if (which == kAccel) scale.mulc(k3_6, k3_6e); // units/s^2 x1000 -> units/min^2
     uint32_t v = best.mul(scale).u32();
     return v ? v : 1;
 }
 
 // Euclidean norm of kAxes 32-bit components.
 Num norm(const uint32_t v[kAxes]) {
-    Num sum{};
+    return sum_squares(v, kAxes).sqrt();
+}
+
+} // namespace
+
+namespace {
+
+// Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated length:
+// Euclidean over the move's group (seed §3.1), at least 1.
+uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uint32_t x[kAxes]) {
+    uint32_t xg[kAxes];
     for (uint8_t a = 0; a < kAxes; ++a) {
-        Num x(v[a]);
-        sum.add(x.mul(x));
+        x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
+        xg[a] = (group & (1u << a)) ? x[a] : 0;
     }
-    return sum.sqrt();
+    uint32_t len = norm(xg).u32();
+    return len ? len : 1;
 }
 
 } // namespace
 
 void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out) {
-    // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated
-    // length: Euclidean over the move's group (seed §3.1).
-    uint32_t x[kAxes], xg[kAxes];
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
-        xg[a] = (group & (1u << a)) ? x[a] : 0;
-    }
-    out.len_q8 = norm(xg).u32();
-    if (out.len_q8 == 0) out.len_q8 = 1;
+    uint32_t x[kAxes];
+    out.len_q8 = travel(m, delta, group, x);
     Num len(out.len_q8);
     out.vmax = limit_along(*m.settings, kRate, x, len);
     out.accel = limit_along(*m.settings, kAccel, x, len);
@@ -79,7 +106,7 @@ void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
 
 uint32_t Planner::nominal2(const PlanBlock& b) {
     Num v(b.feed);
-    return v.mul(v).div(1000000).u32();
+    return v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
 }
 
 // Junction speed squared with the previous move (GRBL's junction deviation, $11), from the
@@ -89,28 +116,46 @@ uint32_t Planner::nominal2(const PlanBlock& b) {
 //   v_junction^2 = a * delta * sin (1 + sin) / q.
 // Writing 1 - sin as q / (1 + sin) keeps full precision on nearly straight paths, where a
 // chain of short segments spends its time; |w| keeps it near reversals.
-uint32_t Planner::junction2(const int32_t unit[kAxes]) const {
-    uint32_t dc[kAxes], wc[kAxes];
+uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
+    uint32_t dc[kAxes];
+    uint32_t a_min = 0xFFFFFFFFul;
+    const Settings& s = *m_->settings;
     for (uint8_t a = 0; a < kAxes; ++a) {
         dc[a] = abs32(unit[a] - prev_unit_[a]); // <= 2^30
-        wc[a] = abs32(unit[a] + prev_unit_[a]);
+        if (dc[a] != 0 && s.axis[a].accel < a_min) a_min = s.axis[a].accel;
     }
-    Num dn = norm(dc);
-    Num q = dn;
-    q.mul(dn).shift(-60);
-    Num sin_half = norm(wc).shift(-30);
+    Num q = sum_squares(dc, kAxes); // |d|^2 / 4
+    q.shift(-60);
     // GRBL's thresholds: |cos theta| > 0.999999 is straight on (no limit) or a reversal
     // (stop), i.e. q or p below 5e-7.
-    Num eps(1);
-    eps.div(2000000);
+    Num eps;
+    eps.m = kMicro; // 5e-7
+    eps.e = -52;
     if (q.cmp(eps) <= 0) return 0xFFFFFFFFul;
-    Num p = sin_half;
-    if (p.mul(sin_half).cmp(eps) <= 0) return 0;
+    // Only min(junction, limit) matters. With p = 1 - q = sin^2 <= 1, sin (1 + sin) >= p >= 1/2
+    // when q <= 1/2, and the junction acceleration (limited per axis along d) is at least the
+    // smallest axis acceleration of d, so
+    //   v_junction^2 >= a_min x 3.6 x delta / (2000 q) >= limit  when  a_min delta >= 1024 q limit
+    // (a margin of 1.8 over every truncation below): then the junction does not limit.
+    // Nearly straight chains of short segments (the common case) stop here.
+    if (q.cmp(Num(1, -1)) <= 0) {
+        Num lhs(a_min);
+        Num rhs(limit);
+        if (lhs.mul(m_->junction_dev_um).cmp(rhs.mul(q).shift(10)) >= 0) return 0xFFFFFFFFul;
+    }
+    Num dn = q;
+    dn.sqrt().shift(30); // |d| in Q29: sqrt(q) * 2 * 2^29
+    // p = 1 - q to 2^-32: near a reversal (p small) its relative error grows to 2^-11 at the
+    // 5e-7 threshold, where v_junction^2 is a few (mm/min)^2, well within a unit.
+    Num p = q;
+    p.set(~p.shift(32).u32(), -32);
+    if (p.cmp(eps) <= 0) return 0;
+    Num sin_half = p.sqrt();
     // Acceleration along the junction vector d, limited per axis; delta in µm / 1000.
-    uint32_t ja = limit_along(*m_->settings, kAccel, dc, dn);
+    uint32_t ja = limit_along(s, kAccel, dc, dn);
     Num r(1);
-    r.add(sin_half).mul(sin_half).div(q).mul(ja).mul(m_->junction_dev_um).div(1000);
-    return r.u32();
+    r.add(sin_half).mul(sin_half).div(q).mul(ja).mul(m_->junction_dev_um);
+    return r.mulc(kMilli, -41).u32(); // / 1000
 }
 
 bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
@@ -138,7 +183,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     b.feed = rapid || feed > lim.vmax ? lim.vmax : feed;
     if (b.feed == 0) b.feed = 1;
     // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000.
-    b.dv2 = Num(lim.len_q8).mul(lim.accel).div(128000).u32();
+    b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
 
     // Unit vector of the commanded move (Q29), for the junction.
     int32_t unit[kAxes];
@@ -151,11 +196,12 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (u > (1ul << 29)) u = 1ul << 29;
         unit[a] = du[a] < 0 ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
-    uint32_t v_junction2 = prev_group_ == b.group && count_ > 0 ? junction2(unit) : 0;
-    for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
     uint32_t prev_nominal2 = count_ > 0 ? nominal2(ring_[index(count_ - 1)]) : 0;
+    uint32_t limit = min32(nominal2(b), prev_nominal2);
+    uint32_t v_junction2 = prev_group_ == b.group && count_ > 0 ? junction2(unit, limit) : 0;
+    for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
     prev_group_ = b.group;
-    b.v_max_entry2 = min32(v_junction2, min32(nominal2(b), prev_nominal2));
+    b.v_max_entry2 = min32(v_junction2, limit);
     b.v_entry2 = 0;
     ++count_;
     recalculate();
@@ -184,10 +230,18 @@ MoveSpec Planner::spec_of_first() const {
     const PlanBlock& b = ring_[head_];
     MoveSpec s;
     for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(b, a);
-    MoveLimits lim;
-    move_limits(*m_, s.delta, b.group, lim);
-    s.len_q8 = lim.len_q8;
-    s.accel = lim.accel;
+    uint32_t x[kAxes];
+    s.len_q8 = travel(*m_, s.delta, b.group, x);
+    if (b.dv2 != 0xFFFFFFFFul) {
+        // The acceleration from dv2 = 2 a L (add()), rounded up so that the step generator's
+        // profile never asks more of the move than the planner allowed for.
+        uint32_t a = Num(b.dv2).mulc(0xFA000000ul, -15).div(s.len_q8).u32(); // x 128000
+        s.accel = add_sat(a, 1 + (a >> 28));
+    } else {
+        MoveLimits lim; // dv2 saturated: the limits again
+        move_limits(*m_, s.delta, b.group, lim);
+        s.accel = lim.accel;
+    }
     s.feed = b.feed;
     s.v_entry2 = b.v_entry2;
     s.v_nominal2 = nominal2(b);

@@ -77,7 +77,9 @@ class Planner {
   private:
     uint8_t index(uint8_t i) const { return static_cast<uint8_t>((head_ + i) % kPlannerSize); }
     void recalculate();
-    uint32_t junction2(const int32_t unit[kAxes]) const;
+    /// Junction speed squared with the previous move, or any value >= `limit` when it is at
+    /// least that (the caller takes the minimum).
+    uint32_t junction2(const int32_t unit[kAxes], uint32_t limit) const;
 
     const Machine* m_;
     uint8_t head_;
