@@ -193,17 +193,33 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
     prof_.cruise = Num(kCruiseNum).mul(len_q8_).div(feed_).div(d1).u32();
-    x2_decel_ = profile_x2_decel(prof_);
+    mark_profile();
     root_valid_ = false;
+}
+
+void StepGen::mark_profile() {
+    x2_decel_ = profile_x2_decel(prof_);
+    // Where profile_a() is exactly A_cruise: from where the start line reaches it (x2 << half
+    // covers |A_entry - A_cruise|, both branches of profile_a) to where the end line leaves it
+    // ((2 d - x2) << half covers A_cruise - A_exit; every position beyond lo when that is 0,
+    // none when it exceeds 2 d). Rounded up: ceil(A / 2^half) = (A + 2^half - 1) >> half.
+    const uint8_t half = static_cast<uint8_t>(prof_.log_s - 1);
+    const uint32_t round = (1ul << half) - 1;
+    uint32_t a = prof_.a_entry, c = prof_.a_cruise;
+    x2_cruise_lo_ = ((a > c ? a - c : c - a) + round) >> half;
+    uint32_t g = (c - prof_.a_exit + round) >> half;
+    x2_cruise_hi_ = g ? 2 * prof_.d - g : 0xFFFFFFFFul;
+    if (g > 2 * prof_.d) x2_cruise_lo_ = 0xFFFFFFFFul;
 }
 
 void StepGen::set_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
+    if (v_exit2 == v_exit2_) return;                     // called at every poll: usually no change
     if (2 * (progress() - origin_) >= x2_decel_) return; // end deceleration already begun
     v_exit2_ = v_exit2;
     prof_.a_exit = a_of(v_exit2);
     if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
-    x2_decel_ = profile_x2_decel(prof_);
+    mark_profile();
 }
 
 void StepGen::hold() {
@@ -310,6 +326,11 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
 }
 
 bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
+    if (!holding_ && x2 >= x2_cruise_lo_ && x2 <= x2_cruise_hi_) {
+        a_last_ = prof_.a_cruise; // profile_a(x2) == a_cruise there: no evaluation
+        delta = prof_.cruise;
+        return true;
+    }
     uint32_t a = profile_a(prof_, x2);
     if (holding_) {
         uint32_t dec = shl_sat(x2 - x2_hold_, static_cast<uint8_t>(prof_.log_s - 1));
@@ -346,9 +367,10 @@ bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
 uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest) {
     uint8_t next = 1;
     if (longest <= 0xFFFF00ul) {
-        const uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8;
-        while (next < kMaxSegmentTicks && delta < target / next) {
+        uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8; // / next: a shift
+        while (next < kMaxSegmentTicks && delta < target) {
             next = static_cast<uint8_t>(next << 1);
+            target >>= 1;
         }
     }
     return next;

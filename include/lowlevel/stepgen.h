@@ -133,6 +133,8 @@ class StepGen {
     void prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
+    /// Sets x2_decel_ and the cruise window from prof_.
+    void mark_profile();
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
     /// Delta_1 (cycles x 256 per reference unit) at half-unit position x2; false when a hold
     /// brings the speed to zero before x2.
@@ -160,10 +162,11 @@ class StepGen {
     uint8_t seen_head_;
     uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
     uint16_t min_period_;
-    uint32_t origin_;     ///< reference tick where the profile starts (moves after a resume)
-    uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
-    uint32_t a_last_;     ///< A of the last segment
-    uint32_t delta_root_; ///< d_num / R for the current R
+    uint32_t origin_;   ///< reference tick where the profile starts (moves after a resume)
+    uint32_t x2_decel_; ///< where the end deceleration starts, half ticks from origin_
+    uint32_t x2_cruise_lo_, x2_cruise_hi_; ///< where the profile is at cruise (profile.h)
+    uint32_t a_last_;                      ///< A of the last segment
+    uint32_t delta_root_;                  ///< d_num / R for the current R
     // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
     uint32_t a_hold_;
     uint32_t x2_hold_;
