@@ -565,20 +565,27 @@ Num sum_squares(const uint32_t v[], uint8_t n) {
     // (travel beyond 4 km) lose their two low bits first.
     uint8_t drop = 0;
     for (uint8_t i = 0; i < n; ++i) {
-        if (v[i] >> 30) drop = 2;
+        if (static_cast<uint8_t>(v[i] >> 24) >= 0x40) drop = 2;
     }
     uint32_t hi = 0, lo = 0;
     for (uint8_t i = 0; i < n; ++i) {
-        uint32_t x = v[i] >> drop;
-        uint32_t l, h = mul_wide(x, x, l);
+        uint32_t x = v[i];
+        if (x == 0) continue;
+        if (drop) x >>= 2;
+        uint32_t l, h = mul64(x, x, l);
         lo += l;
-        hi += h + (lo < l);
+        if (lo < l) ++h; // h <= 2^32 - 2
+        hi += h;
     }
+    return num64(hi, lo, static_cast<int8_t>(2 * drop));
+}
+
+Num num64(uint32_t hi, uint32_t lo, int8_t exp) {
     // Normalise the top word, then shift in the bits of the low word it makes room for.
     Num r;
-    if (hi == 0) return r.set(lo, static_cast<int8_t>(2 * drop));
-    r.set(hi, static_cast<int8_t>(32 + 2 * drop));
-    uint8_t k = static_cast<uint8_t>(32 + 2 * drop - r.e);
+    if (hi == 0) return r.set(lo, exp);
+    r.set(hi, static_cast<int8_t>(32 + exp));
+    uint8_t k = static_cast<uint8_t>(32 + exp - r.e);
     if (k) r.m |= shr_sat(0, lo, static_cast<uint8_t>(32 - k));
     return r;
 }

@@ -27,6 +27,7 @@ uint32_t max3(uint32_t a, uint32_t b, uint32_t c) {
 
 void StepGen::configure(const StepLengths* lengths, uint16_t min_period,
                         const Num* um_q8_per_step) {
+    lens_valid_ = false; // the step lengths may have changed
     lengths_ = lengths;
     min_period_ = min_period;
     um_q8_per_step_ = um_q8_per_step;
@@ -78,17 +79,25 @@ void StepGen::build_k_table(uint8_t group) {
     // regulated axis steps (seed §3.1: the other groups follow) take the mean regulated step
     // time, so the followers move at their average rate rather than in bursts. Altogether
     //   K[P] = L_P * count_g / sum_g  (Q20), and 1 for a run without a regulated axis.
-    uint32_t lens[1u << (kAxes - 1)];
+    // The step lengths (one square root each) depend on the axis sets only: kept from the
+    // previous line (consecutive lines mostly move the same axes in the same order).
+    uint32_t* lens = ln_.lens;
     for (uint8_t sub = 0; sub < sets; ++sub) {
-        lens[sub] = step_length(*lengths_, static_cast<uint8_t>(ln_.mask[sub] & group));
+        uint8_t set = static_cast<uint8_t>(ln_.mask[sub] & group);
+        if (!lens_valid_ || ln_.lens_set[sub] != set) {
+            ln_.lens_set[sub] = set;
+            lens[sub] = step_length(*lengths_, set);
+        }
     }
-    Num sum_g{};
-    uint32_t count_g = 0;
+    lens_valid_ = true;
+    uint32_t sum_hi = 0, sum_lo = 0, count_g = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
     for (uint8_t i = 0; i < m; ++i) {
         uint32_t n = ln_.g.dist[i] - (i + 1 < m ? ln_.g.dist[i + 1] : 0);
         uint32_t len = lens[(1u << i) - 1];
-        if (len != 0) {
-            sum_g.add(Num(n).mul(len));
+        if (len != 0 && n != 0) {
+            uint32_t lo, hi = mul_wide(n, len, lo);
+            sum_lo += lo;
+            sum_hi += hi + (sum_lo < lo);
             count_g += n;
         }
     }
@@ -98,7 +107,7 @@ void StepGen::build_k_table(uint8_t group) {
         return;
     }
     Num r(count_g, 20);
-    r.div(sum_g);
+    r.div(num64(sum_hi, sum_lo));
     ln_.kmax = 0;
     for (uint8_t sub = 0; sub < sets; ++sub) {
         ln_.k[sub] = lens[sub] != 0 ? r.of(lens[sub]) : 1ul << 20;
@@ -115,6 +124,7 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     const CurveParams& c = *spec.curve;
     if (!um_q8_per_step_) return false;
     ln_.g.m = 0;
+    lens_valid_ = false; // the curve's state overwrites the lines
     plane_axes(c.plane, cv_.axes);
     // Machine positions (ticks) and commanded points of the plane (ticks x 256) for the walker:
     // µm x steps per µm, i.e. x 256 / (µm x 256 per step).

@@ -61,6 +61,8 @@ void small_angle_q30(int32_t h, int32_t& c, int32_t& s, int32_t& k);
 /// Sum of the squares of n values as a Num (exact 64-bit sums; truncated to 32 bits once).
 struct Num;
 Num sum_squares(const uint32_t v[], uint8_t n);
+/// (hi * 2^32 + lo) * 2^exp as a Num, truncated; exp <= 95.
+Num num64(uint32_t hi, uint32_t lo, int8_t exp = 0);
 
 /// value = m * 2^e, m normalised to [2^31, 2^32) (or m == 0 for zero).
 struct Num {

@@ -158,6 +158,7 @@ class StepGen {
     bool stopped_;
     bool have_handover_;
     bool root_valid_;
+    bool lens_valid_; ///< ln_.lens holds step lengths (no curve ran since, same settings)
     uint8_t seg_len_;
     uint8_t seen_head_;
     uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
@@ -186,6 +187,10 @@ class StepGen {
         uint32_t kmax;                   ///< largest K of the move
         uint32_t k[1u << (kAxes - 1)];   ///< K table, Q20 (see k())
         uint8_t mask[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
+        // Step length of each sorted set (restricted to the regulated group), kept from one
+        // line to the next while lens_valid_: in the room the curve state leaves.
+        uint32_t lens[1u << (kAxes - 1)];
+        uint8_t lens_set[1u << (kAxes - 1)]; ///< the axis set each length is for
     };
     struct CurveState {
         CurveWalker w;
