@@ -65,7 +65,8 @@ void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[k
         return;
     }
     for (uint8_t j = 1; j < g.m; ++j) {
-        uint32_t acc = c.frac[j] + g.slope[j] * len; // < 2^27 + 2^27 * 16 < 2^32
+        // < 2^27 + 2^27 * 16 < 2^32; one tick per segment is the common case (no product)
+        uint32_t acc = c.frac[j] + (len == 1 ? g.slope[j] : g.slope[j] * len);
         uint8_t inc = static_cast<uint8_t>(acc >> g.shift);
         c.frac[j] = acc & mask;
         c.pos[j] += inc;

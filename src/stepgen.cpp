@@ -8,6 +8,7 @@ namespace {
 // µm x 256 and feeds in mm/min x 1000: 960000000 * len_q8 / (feed * d_1).
 constexpr uint32_t kCruiseNum = 960000000ul;
 static_assert(60ull * kCpuHz * 256 / 1000 * 1000 / 256 == kCruiseNum, "units");
+static_assert(kCruiseNum >> 30 == 0 && (kCruiseNum << 2) >> 31 == 1, "kCruiseNum << 2 normalised");
 // floor(60 * kCpuHz * 256 / 1000 * sqrt(500) / 2): D = 2 * kSqrtCHalf * sqrt(s len_um / (a d_1)),
 // the numerator of Delta_1 = D / sqrt(A) (docs/motion.md, "Wait numerator").
 constexpr uint32_t kSqrtCHalf = 2747680330ul;
@@ -178,20 +179,25 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
 
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
     const uint32_t d1 = ref_len();
+    // One division per constant, by exact 64-bit products (no intermediate quotients).
+    uint32_t lo, hi;
     // Fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
     // l = v^2 rho / (2 a), rho = 1000 d_1 / len_um = 256000 d_1 / len_q8 ticks per mm.
-    Num phi(128000);
-    phi.mul(d1).div(len_q8_).div(accel_);
+    Num phi(d1);
+    hi = mul_wide(len_q8_, accel_, lo);
+    phi.mulc(0xFA000000ul, -15).div(num64(hi, lo)); // x 128000
     // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)), len_um = len_q8 / 256.
     Num dn(len_q8_, -7);
-    dn.div(accel_).div(d1).sqrt().mul(kSqrtCHalf).shift(1);
-    // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 and D below 2^32
-    // (D grows as sqrt(s) = 2^m sqrt(2)).
+    hi = mul_wide(accel_, d1, lo);
+    dn.div(num64(hi, lo)).sqrt().mulc(kSqrtCHalf, 0).shift(1);
+    // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
+    // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
     uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);
     uint8_t m = 4;
-    while (m > 0 && (shl_sat(l_max, static_cast<uint8_t>(2 * m + 1)) > kMaxA ||
-                     Num(dn).shift(static_cast<int8_t>(m)).u32() == 0xFFFFFFFFul)) {
-        --m;
+    for (uint32_t lim = 1ul << 22; m > 0; --m, lim <<= 2) {
+        int8_t de = static_cast<int8_t>(dn.e + m); // D 2^m = dn.m 2^de
+        bool d_full = dn.m != 0 && (de > 0 || (de == 0 && dn.m == 0xFFFFFFFFul));
+        if (l_max <= lim && !d_full) break;
     }
     prof_.log_s = static_cast<uint8_t>(2 * m + 1);
     a_per_v2_ = phi.shift(static_cast<int8_t>(prof_.log_s));
@@ -202,9 +208,18 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
-    prof_.cruise = Num(kCruiseNum).mul(len_q8_).div(feed_).div(d1).u32();
+    hi = mul_wide(feed_, d1, lo);
+    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(num64(hi, lo)).u32();
     mark_profile();
     root_valid_ = false;
+    if (!curve_) {
+        // The runs' periods at cruise, for fill_line (one product per axis set and move).
+        const uint8_t sets = static_cast<uint8_t>(1u << (ln_.g.m - 1));
+        for (uint8_t sub = 0; sub < sets; ++sub) {
+            ln_.cruise_period[sub] = mul_shr(prof_.cruise, ln_.k[sub], 20);
+        }
+        ln_.cruise_seg = next_segment(prof_.cruise, mul_shr(prof_.cruise, ln_.kmax, 20));
+    }
 }
 
 void StepGen::mark_profile() {
@@ -309,7 +324,7 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
     }
     if (period > kMaxPeriodCycles) period = kMaxPeriodCycles;
     if (period <= 0xFFFF) {
-        uint32_t units = (period * count) >> 10; // < 2^14
+        uint32_t units = (count == 1 ? period : period * count) >> 10; // < 2^14
         slot_time_[q.tail] = units > 255 ? 255 : static_cast<uint8_t>(units);
         queued_ = static_cast<uint16_t>(queued_ + slot_time_[q.tail]);
         q.push(Run{steps, dirs, count, static_cast<uint16_t>(period)});
@@ -406,14 +421,17 @@ void StepGen::fill_line(RunQueue& q) {
         line_advance(ln_.g, ln_.c, len, e);
         MicroRun runs[kAxes];
         uint8_t n = micro_split(e, ln_.g.m, runs);
+        // At cruise (most segments of a job) the periods are the move's constants.
+        const bool at_cruise = delta == prof_.cruise;
         for (uint8_t i = 0; i < n; ++i) {
             uint8_t idx = static_cast<uint8_t>(runs[i].set >> 1);
-            emit(q, ln_.mask[idx], ln_.g.dirs, runs[i].count, mul_shr(delta, ln_.k[idx], 20));
+            emit(q, ln_.mask[idx], ln_.g.dirs, runs[i].count,
+                 at_cruise ? ln_.cruise_period[idx] : mul_shr(delta, ln_.k[idx], 20));
         }
 #if LL_STATS
         ++stats.segments;
 #endif
-        seg_len_ = next_segment(delta, mul_shr(delta, ln_.kmax, 20));
+        seg_len_ = at_cruise ? ln_.cruise_seg : next_segment(delta, mul_shr(delta, ln_.kmax, 20));
         if (ln_.c.x1 == ln_.g.dist[0]) finish_move();
     }
 }
