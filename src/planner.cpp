@@ -81,9 +81,21 @@ uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uin
 void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out) {
     uint32_t x[kAxes];
     out.len_q8 = travel(m, delta, group, x);
-    Num len(out.len_q8);
-    out.vmax = limit_along(*m.settings, kRate, x, len);
-    out.accel = limit_along(*m.settings, kAccel, x, len);
+    // limit_along() for both limits, sharing len / x[a] when one axis bounds both (the common
+    // case): one division.
+    const Settings& s = *m.settings;
+    uint8_t ar = tightest(s, kRate, x), aa = tightest(s, kAccel, x);
+    if (ar == kAxes) {
+        out.vmax = out.accel = 0xFFFFFFFFul; // nothing moves
+        return;
+    }
+    Num r(out.len_q8);
+    r.div(x[ar]);
+    uint32_t v = r.of(s.axis[ar].max_rate);
+    out.vmax = v ? v : 1;
+    if (aa != ar) r.set(out.len_q8).div(x[aa]);
+    v = r.mulc(k3_6, k3_6e).of(s.axis[aa].accel); // units/s^2 x1000 -> units/min^2
+    out.accel = v ? v : 1;
 }
 
 int32_t Planner::delta(const PlanBlock& b, uint8_t axis) {
@@ -104,9 +116,18 @@ void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
     }
 }
 
-uint32_t Planner::nominal2(const PlanBlock& b) {
-    Num v(b.feed);
+namespace {
+
+// Squared speed of a feed (units/min x1000), (units/min)^2.
+uint32_t speed2_of(uint32_t feed) {
+    Num v(feed);
     return v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
+}
+
+} // namespace
+
+uint32_t Planner::nominal2(const PlanBlock& b) {
+    return speed2_of(b.feed);
 }
 
 // Junction speed squared with the previous move (GRBL's junction deviation, $11), from the
@@ -196,8 +217,8 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (u > (1ul << 29)) u = 1ul << 29;
         unit[a] = du[a] < 0 ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
-    uint32_t prev_nominal2 = count_ > 0 ? nominal2(ring_[index(count_ - 1)]) : 0;
-    uint32_t limit = min32(nominal2(b), prev_nominal2);
+    // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
+    uint32_t limit = count_ > 0 ? speed2_of(min32(b.feed, ring_[index(count_ - 1)].feed)) : 0;
     uint32_t v_junction2 = prev_group_ == b.group && count_ > 0 ? junction2(unit, limit) : 0;
     for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
     prev_group_ = b.group;
