@@ -181,15 +181,20 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
 
 bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                   bool rapid) {
+    // Few locals: the ATmega328P addresses only 64 bytes of a stack frame directly.
     PlanBlock& b = ring_[index(count_)];
+    int32_t d[kAxes];
+    uint32_t xu[kAxes]; // |commanded travel| (µm) on the regulated axes, then the unit vector
+    uint8_t neg = 0;    // axes whose commanded travel is negative
     bool moves = false;
-    int32_t d[kAxes], du[kAxes];
     for (uint8_t a = 0; a < kAxes; ++a) {
         d[a] = target[a] - last_[a];
-        du[a] = target_um[a] - last_um_[a];
         if (d[a] != 0) moves = true;
+        int32_t du = target_um[a] - last_um_[a];
+        last_um_[a] = target_um[a];
+        if (du < 0) neg = static_cast<uint8_t>(neg | (1u << a));
+        xu[a] = abs32(du);
     }
-    for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
     if (!moves) return false;
     for (uint8_t a = 0; a < kAxes; ++a) {
         last_[a] = target[a];
@@ -198,30 +203,35 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         b.delta[a][1] = static_cast<uint8_t>(v >> 8);
         b.delta[a][2] = static_cast<uint8_t>(v >> 16);
     }
-    b.group = regulated_group(*m_, d);
-    MoveLimits lim;
-    move_limits(*m_, d, b.group, lim);
-    b.feed = rapid || feed > lim.vmax ? lim.vmax : feed;
-    if (b.feed == 0) b.feed = 1;
-    // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000.
-    b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
+    const uint8_t group = regulated_group(*m_, d);
+    b.group = group;
+    {
+        MoveLimits lim;
+        move_limits(*m_, d, group, lim);
+        b.feed = rapid || feed > lim.vmax ? lim.vmax : feed;
+        if (b.feed == 0) b.feed = 1;
+        // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000.
+        uint32_t lo, hi = mul_wide(lim.len_q8, lim.accel, lo);
+        b.dv2 = num64(hi, lo).mulc(kMilli, -48).u32();
+    }
 
-    // Unit vector of the commanded move (Q29), for the junction.
-    int32_t unit[kAxes];
-    uint32_t xu[kAxes];
-    for (uint8_t a = 0; a < kAxes; ++a) xu[a] = (b.group & (1u << a)) ? abs32(du[a]) : 0;
+    // Unit vector of the commanded move (Q29), for the junction, in place of xu.
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        if (!(group & (1u << a))) xu[a] = 0;
+    }
     Num to_unit(1, 29);
     to_unit.div(norm(xu));
+    int32_t* unit = reinterpret_cast<int32_t*>(xu);
     for (uint8_t a = 0; a < kAxes; ++a) {
         uint32_t u = to_unit.of(xu[a]);
         if (u > (1ul << 29)) u = 1ul << 29;
-        unit[a] = du[a] < 0 ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+        unit[a] = (neg & (1u << a)) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
     // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
     uint32_t limit = count_ > 0 ? speed2_of(min32(b.feed, ring_[index(count_ - 1)].feed)) : 0;
-    uint32_t v_junction2 = prev_group_ == b.group && count_ > 0 ? junction2(unit, limit) : 0;
+    uint32_t v_junction2 = prev_group_ == group && count_ > 0 ? junction2(unit, limit) : 0;
     for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
-    prev_group_ = b.group;
+    prev_group_ = group;
     b.v_max_entry2 = min32(v_junction2, limit);
     b.v_entry2 = 0;
     ++count_;
