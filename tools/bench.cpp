@@ -392,6 +392,13 @@ FnList extra_fns() {
     return out;
 }
 
+/// The circle's feed, mm/min: 3000 (the figure of the issue) unless LLBENCH_CIRCLE_FEED says
+/// otherwise (to look at the producer when it keeps up).
+double circle_feed() {
+    const char* env = getenv("LLBENCH_CIRCLE_FEED");
+    return env ? atof(env) : 3000;
+}
+
 // ---- circle of short segments -------------------------------------------------------------
 
 struct CircleRun {
@@ -421,7 +428,7 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
     CircleRun c;
     Board b(cfg.elf);
     b.settings({"$100=80", "$101=80", "$110=5000", "$111=5000", "$120=1000", "$121=1000"});
-    const std::vector<std::string> job = circle_job(radius, 0.1, 3000);
+    const std::vector<std::string> job = circle_job(radius, 0.1, circle_feed());
     c.lines = job.size();
     std::unique_ptr<Profiler> prof;
     const std::string kExecute = "_ZN2ll5gcode7executeEPKchRNS0_7OutcomeE";
@@ -794,7 +801,7 @@ int main(int argc, char** argv) {
     }
 
     if (cfg.want("circle")) {
-        const double radius = cfg.quick ? 1 : 10, v = 50.0, acc = 1000.0;
+        const double radius = cfg.quick ? 1 : 10, v = circle_feed() / 60, acc = 1000.0;
         const double ideal = 2 * kPi * radius / v + v / acc;
         std::cout << fmt("\n## Circle r = %g mm of 0.1 mm G1 segments, F3000, 80 steps/mm, "
                          "1000 mm/s², 115200 baud\n",
