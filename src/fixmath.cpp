@@ -580,6 +580,7 @@ Num sum_squares(const uint32_t v[], uint8_t n) {
     return num64(hi, lo, static_cast<int8_t>(2 * drop));
 }
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num num64(uint32_t hi, uint32_t lo, int8_t exp) {
     // Normalise the top word, then shift in the bits of the low word it makes room for.
     Num r;
@@ -589,6 +590,7 @@ Num num64(uint32_t hi, uint32_t lo, int8_t exp) {
     if (k) r.m |= shr_sat(0, lo, static_cast<uint8_t>(32 - k));
     return r;
 }
+#endif
 
 #if !defined(__AVR__) // AVR: fixmath_avr.cpp
 uint32_t Num::u32() const {

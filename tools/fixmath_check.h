@@ -70,6 +70,10 @@ inline uint32_t fixmath_hash(uint16_t rounds) {
         h.add(x.of(b));
         h.add(Num(a).div(b | 1).of(a));
         h.add(static_cast<uint32_t>(x.cmp(y)));
+        h.add(num64(any(s), any(s),
+                    static_cast<int8_t>(static_cast<int16_t>(xorshift(s) % 80) - 40)));
+        uint32_t v[4] = {any(s), any(s), 0, any(s) >> (xorshift(s) & 7)};
+        h.add(sum_squares(v, 4));
     }
     return h.h;
 }
