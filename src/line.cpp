@@ -31,21 +31,21 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     uint8_t k = 3;
     while ((1ul << k) < 8ul * d1) ++k;
     g.shift = k;
-    g.slope[0] = 1ul << k;
+    g.slope[0] = 1ul << kLineUnit;
     for (uint8_t j = 1; j < g.m; ++j) {
-        // round(d_j * 2^k / d_1) = floor((2 d_j * 2^k / d_1 + 1) / 2)
+        // round(d_j * 2^k / d_1) = floor((2 d_j * 2^k / d_1 + 1) / 2), then in units of
+        // 2^(kLineUnit - k) (the same value, aligned: line_advance shifts by a constant).
         uint32_t twice = div_frac(g.dist[j], d1, static_cast<uint8_t>(k + 1));
-        g.slope[j] = (twice + 1) >> 1;
+        g.slope[j] = ((twice + 1) >> 1) << (kLineUnit - k);
     }
     return true;
 }
 
 void line_start(const LineGeometry& g, LineCursor& c) {
     c.x1 = 0;
-    uint32_t half = 1ul << (g.shift - 1);
     for (uint8_t j = 0; j < g.m; ++j) {
         c.pos[j] = 0;
-        c.frac[j] = half;
+        c.frac[j] = 1ul << (kLineUnit - 1); // P/2
     }
 }
 
@@ -53,7 +53,6 @@ void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[k
     c.x1 += len;
     c.pos[0] += len;
     e[0] = len;
-    const uint32_t mask = (1ul << g.shift) - 1;
     if (c.x1 == g.dist[0]) {
         // Last segment: S_j * d_1 + P/2 lands within 1/8 tick of d_j + 1/2 by construction
         // (|d_1 (S_j / P - s_j)| <= d_1 / (2P) <= 1/16), so the formula gives d_j exactly;
@@ -67,8 +66,10 @@ void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[k
     for (uint8_t j = 1; j < g.m; ++j) {
         // < 2^27 + 2^27 * 16 < 2^32; one tick per segment is the common case (no product)
         uint32_t acc = c.frac[j] + (len == 1 ? g.slope[j] : g.slope[j] * len);
-        uint8_t inc = static_cast<uint8_t>(acc >> g.shift);
-        c.frac[j] = acc & mask;
+        // acc >> 27 from the top byte: avr-gcc 5.4 makes a 27-turn loop of a 32-bit shift
+        uint8_t top = static_cast<uint8_t>(acc >> 24);
+        uint8_t inc = static_cast<uint8_t>(top >> (kLineUnit - 24));
+        c.frac[j] = acc & ((1ul << kLineUnit) - 1);
         c.pos[j] += inc;
         e[j] = inc;
     }

@@ -240,20 +240,27 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
 }
 
 void Planner::recalculate() {
+    // Pointer walks (an index modulo the ring and a 29-byte stride per block cost more than the
+    // passes themselves on the ATmega328P).
+    PlanBlock* const first = ring_;
+    PlanBlock* const last = ring_ + (kPlannerSize - 1);
     // Backward pass: each move must be able to slow down to the next one's entry (0 after the
     // last move). The move being executed keeps its entry speed.
+    PlanBlock* b = &ring_[index(static_cast<uint8_t>(count_ - 1))];
     uint32_t next_entry = 0;
-    for (uint8_t i = count_; i-- > first_begun_;) {
-        PlanBlock& b = ring_[index(i)];
-        b.v_entry2 = min32(b.v_max_entry2, add_sat(next_entry, b.dv2));
-        next_entry = b.v_entry2;
+    for (uint8_t n = static_cast<uint8_t>(count_ - first_begun_); n != 0; --n) {
+        uint32_t v = add_sat(next_entry, b->dv2);
+        if (v > b->v_max_entry2) v = b->v_max_entry2;
+        b->v_entry2 = v;
+        next_entry = v;
+        b = b == first ? last : b - 1;
     }
     // Forward pass: no move can enter faster than the previous one can accelerate to.
-    for (uint8_t i = 0; i + 1 < count_; ++i) {
-        const PlanBlock& b = ring_[index(i)];
-        PlanBlock& n = ring_[index(static_cast<uint8_t>(i + 1))];
-        uint32_t reach = add_sat(b.v_entry2, b.dv2);
-        if (n.v_entry2 > reach) n.v_entry2 = reach;
+    b = &ring_[head_];
+    for (uint8_t n = count_; n > 1; --n) {
+        uint32_t reach = add_sat(b->v_entry2, b->dv2);
+        b = b == last ? first : b + 1;
+        if (b->v_entry2 > reach) b->v_entry2 = reach;
     }
 }
 
@@ -267,7 +274,8 @@ MoveSpec Planner::spec_of_first() const {
         // The acceleration from dv2 = 2 a L (add()), rounded up so that the step generator's
         // profile never asks more of the move than the planner allowed for.
         uint32_t a = Num(b.dv2).mulc(0xFA000000ul, -15).div(s.len_q8).u32(); // x 128000
-        s.accel = add_sat(a, 1 + (a >> 28));
+        uint8_t top = static_cast<uint8_t>(a >> 24);
+        s.accel = add_sat(a, 1u + static_cast<uint8_t>(top >> 4)); // 1 + a >> 28
     } else {
         MoveLimits lim; // dv2 saturated: the limits again
         move_limits(*m_, s.delta, b.group, lim);

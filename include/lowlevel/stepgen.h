@@ -190,7 +190,7 @@ class StepGen {
         // Step length of each sorted set (restricted to the regulated group), kept from one
         // line to the next while lens_valid_: in the room the curve state leaves.
         uint32_t lens[1u << (kAxes - 1)];
-        uint8_t lens_set[1u << (kAxes - 1)]; ///< the axis set each length is for
+        uint8_t lens_set[1u << (kAxes - 1)];       ///< the axis set each length is for
         uint32_t cruise_period[1u << (kAxes - 1)]; ///< K * Delta_1 at cruise, cycles x 256
         uint8_t cruise_seg;                        ///< segment length at cruise
     };
