@@ -208,6 +208,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     {
         MoveLimits lim;
         move_limits(*m_, d, group, lim);
+        b.len_q8 = lim.len_q8;
         b.feed = rapid || feed > lim.vmax ? lim.vmax : feed;
         if (b.feed == 0) b.feed = 1;
         // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000.
@@ -268,18 +269,14 @@ MoveSpec Planner::spec_of_first() const {
     const PlanBlock& b = ring_[head_];
     MoveSpec s;
     for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(b, a);
-    uint32_t x[kAxes];
-    s.len_q8 = travel(*m_, s.delta, b.group, x);
-    if (b.dv2 != 0xFFFFFFFFul) {
-        // The acceleration from dv2 = 2 a L (add()), rounded up so that the step generator's
-        // profile never asks more of the move than the planner allowed for.
-        uint32_t a = Num(b.dv2).mulc(0xFA000000ul, -15).div(s.len_q8).u32(); // x 128000
-        uint8_t top = static_cast<uint8_t>(a >> 24);
-        s.accel = add_sat(a, 1u + static_cast<uint8_t>(top >> 4)); // 1 + a >> 28
-    } else {
-        MoveLimits lim; // dv2 saturated: the limits again
+    s.len_q8 = b.len_q8;
+    s.accel = 0;
+    s.dv2 = b.dv2; // the profile from the planner's own 2 a L
+    if (b.dv2 == 0xFFFFFFFFul) {
+        MoveLimits lim; // dv2 saturated: the acceleration from the limits again
         move_limits(*m_, s.delta, b.group, lim);
         s.accel = lim.accel;
+        s.dv2 = 0;
     }
     s.feed = b.feed;
     s.v_entry2 = b.v_entry2;

@@ -42,11 +42,7 @@ bool StepGen::begin(const MoveSpec& spec) {
         ln_.g.m = 0;
         return false;
     }
-    len_q8_ = spec.len_q8;
-    accel_ = spec.accel;
-    feed_ = spec.feed;
-    v_nominal2_ = spec.v_nominal2;
-    v_exit2_ = spec.v_exit2;
+    take_spec(spec);
     line_start(ln_.g, ln_.c);
     build_k_table(spec.group);
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
@@ -154,11 +150,7 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
                                   : cv_.w.bezier(e, centre, other);
     if (!ok) return false;
     curve_ = &c;
-    len_q8_ = spec.len_q8;
-    accel_ = spec.accel;
-    feed_ = spec.feed;
-    v_nominal2_ = spec.v_nominal2;
-    v_exit2_ = spec.v_exit2;
+    take_spec(spec);
     // The profile's reference axis is a virtual one with 1000 ticks per mm (µm) along the path.
     cv_.ref_um = len_q8_ >> 8;
     if (cv_.ref_um == 0) cv_.ref_um = 1;
@@ -177,19 +169,38 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     return true;
 }
 
+void StepGen::take_spec(const MoveSpec& spec) {
+    len_q8_ = spec.len_q8;
+    feed_ = spec.feed;
+    v_nominal2_ = spec.v_nominal2;
+    v_exit2_ = spec.v_exit2;
+    if (spec.dv2) {
+        dv2_.set(spec.dv2);
+    } else { // 2 a L = 2 accel len_q8 / 256000
+        uint32_t lo, hi = mul_wide(spec.len_q8, spec.accel, lo);
+        dv2_ = num64(hi, lo).mulc(0x83126E97ul, -48); // / 128000
+    }
+}
+
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
     const uint32_t d1 = ref_len();
-    // One division per constant, by exact 64-bit products (no intermediate quotients).
+    // From psi = 1 / (dv2 d_1), one division (dv2 = 2 a L, a = 128000 dv2 / len_q8):
+    // fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
+    //   l = v^2 rho / (2 a), rho = 256000 d_1 / len_q8 ticks per mm, so phi = d_1 / dv2 = psi d_1^2;
+    // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD len_q8 sqrt(psi),
+    //   kD = 2 kSqrtCHalf / sqrt(2^7 128000).
     uint32_t lo, hi;
-    // Fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
-    // l = v^2 rho / (2 a), rho = 1000 d_1 / len_um = 256000 d_1 / len_q8 ticks per mm.
-    Num phi(d1);
-    hi = mul_wide(len_q8_, accel_, lo);
-    phi.mulc(0xFA000000ul, -15).div(num64(hi, lo)); // x 128000
-    // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)), len_um = len_q8 / 256.
-    Num dn(len_q8_, -7);
-    hi = mul_wide(accel_, d1, lo);
-    dn.div(num64(hi, lo)).sqrt().mulc(kSqrtCHalf, 0).shift(1);
+    Num psi(d1);
+    psi.mul(dv2_);
+    {
+        Num one(1);
+        psi = one.div(psi);
+    }
+    Num phi = psi;
+    hi = mul_wide(d1, d1, lo);
+    phi.mul(num64(hi, lo));
+    Num dn = psi;
+    dn.sqrt().mul(Num(len_q8_)).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
     uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);

@@ -38,7 +38,10 @@ constexpr uint32_t kMaxPeriodCycles = 256ul * 65000;
 struct MoveSpec {
     int32_t delta[kAxes]; ///< ticks per machine axis
     uint32_t len_q8;      ///< length of the regulated path (axes of `group`), µm x 256
-    uint32_t accel;       ///< acceleration along the regulated path, mm/min^2
+    uint32_t accel;       ///< acceleration along the regulated path, mm/min^2 (unless dv2)
+    /// 2 a L along the path, (mm/min)^2, as the planner has it (0: from len_q8 and accel). The
+    /// profile is derived from it directly, which spares a division.
+    uint32_t dv2;
     uint32_t feed;        ///< nominal speed along the regulated path, mm/min x1000
     uint32_t v_entry2;    ///< entry speed squared, (mm/min)^2
     uint32_t v_nominal2;  ///< nominal speed squared, (mm/min)^2
@@ -131,6 +134,7 @@ class StepGen {
   private:
     bool begin_curve(const MoveSpec& spec);
     void prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks);
+    void take_spec(const MoveSpec& spec);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
     /// Sets x2_decel_ and the cruise window from prof_.
@@ -176,7 +180,8 @@ class StepGen {
     SqrtTracker root_;
     Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
     // What remains needed of the MoveSpec after begin().
-    uint32_t len_q8_, accel_, feed_, v_nominal2_, v_exit2_;
+    uint32_t len_q8_, feed_, v_nominal2_, v_exit2_;
+    Num dv2_; ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
     // The move being produced: a line or a curve, never both, so they share their memory.
