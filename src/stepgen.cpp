@@ -213,9 +213,10 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     prof_.log_s = static_cast<uint8_t>(2 * m + 1);
     a_per_v2_ = phi.shift(static_cast<int8_t>(prof_.log_s));
     prof_.d = remaining_ticks;
-    prof_.a_entry = a_of(v_entry2);
+    // Chains of moves mostly enter and leave at their cruise speed: one product then.
     prof_.a_cruise = a_of(v_nominal2_);
-    prof_.a_exit = a_of(v_exit2);
+    prof_.a_entry = v_entry2 == v_nominal2_ ? prof_.a_cruise : a_of(v_entry2);
+    prof_.a_exit = v_exit2 == v_nominal2_ ? prof_.a_cruise : a_of(v_exit2);
     if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
@@ -234,6 +235,13 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
 }
 
 void StepGen::mark_profile() {
+    if (prof_.a_entry == prof_.a_cruise && prof_.a_exit == prof_.a_cruise) {
+        // Cruise from end to end (what profile_x2_decel and the lines below give then).
+        x2_decel_ = 2 * prof_.d;
+        x2_cruise_lo_ = 0;
+        x2_cruise_hi_ = 0xFFFFFFFFul;
+        return;
+    }
     x2_decel_ = profile_x2_decel(prof_);
     // Where profile_a() is exactly A_cruise: from where the start line reaches it (x2 << half
     // covers |A_entry - A_cruise|, both branches of profile_a) to where the end line leaves it
