@@ -307,6 +307,12 @@ uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits) {
     return q;
 }
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
+uint32_t div32_16(uint32_t n, uint16_t d) {
+    return n / d;
+}
+#endif
+
 uint32_t mul_wide(uint32_t a, uint32_t b, uint32_t& lo) {
     return mul64(a, b, lo);
 }

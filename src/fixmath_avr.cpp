@@ -483,4 +483,36 @@ asm(".section .text._ZN2ll5num64Emma,\"ax\",@progbits\n"
     ".size _ZN2ll5num64Emma, .-_ZN2ll5num64Emma\n"
     ".text\n");
 
+// uint32_t div32_16(uint32_t n, uint16_t d): n in r22..r25, d in r20:r21; the quotient in
+// r22..r25. Restoring division: n shifts into a 16-bit remainder (its 17th bit in the carry)
+// and the quotient bits into the room n leaves.
+asm(".section .text._ZN2ll8div32_16Emj,\"ax\",@progbits\n"
+    ".global _ZN2ll8div32_16Emj\n"
+    ".type _ZN2ll8div32_16Emj, @function\n"
+    "_ZN2ll8div32_16Emj:\n"
+    "clr  r26\n"
+    "clr  r27\n"
+    "ldi  r30, 32\n"
+    "1:\n"
+    "lsl  r22\n"
+    "rol  r23\n"
+    "rol  r24\n"
+    "rol  r25\n"
+    "rol  r26\n"
+    "rol  r27\n"
+    "brcs 2f\n"
+    "cp   r26, r20\n"
+    "cpc  r27, r21\n"
+    "brcs 3f\n"
+    "2:\n"
+    "sub  r26, r20\n"
+    "sbc  r27, r21\n"
+    "inc  r22\n"
+    "3:\n"
+    "dec  r30\n"
+    "brne 1b\n"
+    "ret\n"
+    ".size _ZN2ll8div32_16Emj, .-_ZN2ll8div32_16Emj\n"
+    ".text\n");
+
 #endif // __AVR__

@@ -33,6 +33,10 @@ uint32_t shr64_sat(uint32_t hi, uint32_t lo, uint8_t shift);
 /// floor(a * b / 2^shift), saturated to 2^32 - 1 (shift <= 63).
 uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift);
 
+/// floor(n / d) for a 16-bit divisor d != 0 (the step generator's D / R): 32 turns of a 17-bit
+/// remainder on the ATmega328P instead of the library's 32-bit one.
+uint32_t div32_16(uint32_t n, uint16_t d);
+
 /// min(x << k, 2^32 - 1).
 uint32_t shl_sat(uint32_t x, uint8_t k);
 /// min(a + b, 2^32 - 1).
