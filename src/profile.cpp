@@ -15,23 +15,9 @@ uint32_t profile_x2_decel(const Profile& p) {
     return x2;
 }
 
-namespace {
-
-// min(x << k, 2^32 - 1) for the profile's small shifts (k < 9), a bit at a time: shl_sat()
-// tests x against 2^32 >> k first, another variable shift (a loop on the ATmega328P).
-uint32_t shl_small(uint32_t x, uint8_t k) {
-    for (; k != 0; --k) {
-        if (x & 0x80000000ul) return 0xFFFFFFFFul;
-        x <<= 1;
-    }
-    return x;
-}
-
-} // namespace
-
 uint32_t profile_a(const Profile& p, uint32_t x2) {
     const uint8_t half = static_cast<uint8_t>(p.log_s - 1); // s * x2 / 2 = x2 << half
-    uint32_t travelled = shl_small(x2, half);
+    uint32_t travelled = shl_sat(x2, half);
     uint32_t start;
     if (p.a_entry <= p.a_cruise) {
         start = add_sat(p.a_entry, travelled);
@@ -40,7 +26,7 @@ uint32_t profile_a(const Profile& p, uint32_t x2) {
         start = travelled >= p.a_entry - p.a_cruise ? p.a_cruise : p.a_entry - travelled;
     }
     uint32_t to_go2 = 2 * p.d >= x2 ? 2 * p.d - x2 : 0;
-    uint32_t end = add_sat(p.a_exit, shl_small(to_go2, half));
+    uint32_t end = add_sat(p.a_exit, shl_sat(to_go2, half));
     return start < end ? start : end;
 }
 

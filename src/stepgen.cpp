@@ -174,19 +174,16 @@ void StepGen::take_spec(const MoveSpec& spec) {
     feed_ = spec.feed;
     v_nominal2_ = spec.v_nominal2;
     v_exit2_ = spec.v_exit2;
-    if (spec.dv2) {
-        dv2_.set(spec.dv2);
-    } else { // 2 a L = 2 accel len_q8 / 256000
-        uint32_t lo, hi = mul_wide(spec.len_q8, spec.accel, lo);
-        dv2_ = num64(hi, lo).mulc(0x83126E97ul, -48); // / 128000
-    }
+    dv2_.set(spec.dv2);
+    if (!spec.dv2) dv2_.set(spec.len_q8).mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
 }
 
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
     const uint32_t d1 = ref_len();
     // From psi = 1 / (dv2 d_1), one division (dv2 = 2 a L, a = 128000 dv2 / len_q8):
     // fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
-    //   l = v^2 rho / (2 a), rho = 256000 d_1 / len_q8 ticks per mm, so phi = d_1 / dv2 = psi d_1^2;
+    //   l = v^2 rho / (2 a), rho = 256000 d_1 / len_q8 ticks per mm, so phi = d_1 / dv2 = psi
+    //   d_1^2;
     // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD len_q8 sqrt(psi),
     //   kD = 2 kSqrtCHalf / sqrt(2^7 128000).
     uint32_t lo, hi;
@@ -235,25 +232,11 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
 }
 
 void StepGen::mark_profile() {
-    if (prof_.a_entry == prof_.a_cruise && prof_.a_exit == prof_.a_cruise) {
-        // Cruise from end to end (what profile_x2_decel and the lines below give then).
-        x2_decel_ = 2 * prof_.d;
-        x2_cruise_lo_ = 0;
-        x2_cruise_hi_ = 0xFFFFFFFFul;
-        return;
-    }
-    x2_decel_ = profile_x2_decel(prof_);
-    // Where profile_a() is exactly A_cruise: from where the start line reaches it (x2 << half
-    // covers |A_entry - A_cruise|, both branches of profile_a) to where the end line leaves it
-    // ((2 d - x2) << half covers A_cruise - A_exit; every position beyond lo when that is 0,
-    // none when it exceeds 2 d). Rounded up: ceil(A / 2^half) = (A + 2^half - 1) >> half.
-    const uint8_t half = static_cast<uint8_t>(prof_.log_s - 1);
-    const uint32_t round = (1ul << half) - 1;
-    uint32_t a = prof_.a_entry, c = prof_.a_cruise;
-    x2_cruise_lo_ = ((a > c ? a - c : c - a) + round) >> half;
-    uint32_t g = (c - prof_.a_exit + round) >> half;
-    x2_cruise_hi_ = g ? 2 * prof_.d - g : 0xFFFFFFFFul;
-    if (g > 2 * prof_.d) x2_cruise_lo_ = 0xFFFFFFFFul;
+    // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
+    // A_cruise everywhere and the end deceleration starts at its end (what profile_x2_decel
+    // gives then). Chains of short moves are made of such moves.
+    cruising_ = prof_.a_entry == prof_.a_cruise && prof_.a_exit == prof_.a_cruise;
+    x2_decel_ = cruising_ ? 2 * prof_.d : profile_x2_decel(prof_);
 }
 
 void StepGen::set_exit(uint32_t v_exit2) {
@@ -371,8 +354,8 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
 }
 
 bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
-    if (!holding_ && x2 >= x2_cruise_lo_ && x2 <= x2_cruise_hi_) {
-        a_last_ = prof_.a_cruise; // profile_a(x2) == a_cruise there: no evaluation
+    if (cruising_ && !holding_) {
+        a_last_ = prof_.a_cruise; // profile_a(x2) == a_cruise: no evaluation
         delta = prof_.cruise;
         return true;
     }

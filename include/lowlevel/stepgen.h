@@ -42,11 +42,11 @@ struct MoveSpec {
     /// 2 a L along the path, (mm/min)^2, as the planner has it (0: from len_q8 and accel). The
     /// profile is derived from it directly, which spares a division.
     uint32_t dv2;
-    uint32_t feed;        ///< nominal speed along the regulated path, mm/min x1000
-    uint32_t v_entry2;    ///< entry speed squared, (mm/min)^2
-    uint32_t v_nominal2;  ///< nominal speed squared, (mm/min)^2
-    uint32_t v_exit2;     ///< exit speed squared, (mm/min)^2
-    uint8_t group;        ///< regulated axes G (bit a = machine axis a)
+    uint32_t feed;       ///< nominal speed along the regulated path, mm/min x1000
+    uint32_t v_entry2;   ///< entry speed squared, (mm/min)^2
+    uint32_t v_nominal2; ///< nominal speed squared, (mm/min)^2
+    uint32_t v_exit2;    ///< exit speed squared, (mm/min)^2
+    uint8_t group;       ///< regulated axes G (bit a = machine axis a)
     /// The curve followed from the current position to `delta` further, or nullptr for a line.
     /// Must stay valid until the move is fully produced (the planner keeps it in a slot).
     const CurveParams* curve;
@@ -137,7 +137,7 @@ class StepGen {
     void take_spec(const MoveSpec& spec);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
-    /// Sets x2_decel_ and the cruise window from prof_.
+    /// Sets x2_decel_ and cruising_ from prof_.
     void mark_profile();
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
     /// Delta_1 (cycles x 256 per reference unit) at half-unit position x2; false when a hold
@@ -163,15 +163,15 @@ class StepGen {
     bool have_handover_;
     bool root_valid_;
     bool lens_valid_; ///< ln_.lens holds step lengths (no curve ran since, same settings)
+    bool cruising_;   ///< the profile is at cruise from end to end (mark_profile())
     uint8_t seg_len_;
     uint8_t seen_head_;
     uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
     uint16_t min_period_;
-    uint32_t origin_;   ///< reference tick where the profile starts (moves after a resume)
-    uint32_t x2_decel_; ///< where the end deceleration starts, half ticks from origin_
-    uint32_t x2_cruise_lo_, x2_cruise_hi_; ///< where the profile is at cruise (profile.h)
-    uint32_t a_last_;                      ///< A of the last segment
-    uint32_t delta_root_;                  ///< d_num / R for the current R
+    uint32_t origin_;     ///< reference tick where the profile starts (moves after a resume)
+    uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
+    uint32_t a_last_;     ///< A of the last segment
+    uint32_t delta_root_; ///< d_num / R for the current R
     // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
     uint32_t a_hold_;
     uint32_t x2_hold_;
