@@ -531,6 +531,7 @@ Num& Num::div(uint32_t v) {
     return div(Num(v));
 }
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::add(const Num& o) {
     if (o.m == 0) return *this;
     if (m == 0) return *this = o;
@@ -551,6 +552,7 @@ Num& Num::add(const Num& o) {
     e = big.e;
     return *this;
 }
+#endif
 
 Num& Num::sqrt() {
     if (m == 0) return *this;
@@ -618,11 +620,13 @@ uint32_t Num::of(uint32_t x) const {
     return mul_shr(x, m, static_cast<uint8_t>(-e));
 }
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 int8_t Num::cmp(const Num& o) const {
     if (m == 0 || o.m == 0) return m == o.m ? 0 : (m == 0 ? -1 : 1);
     if (e != o.e) return e < o.e ? -1 : 1;
     if (m != o.m) return m < o.m ? -1 : 1;
     return 0;
 }
+#endif
 
 } // namespace ll

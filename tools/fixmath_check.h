@@ -75,6 +75,17 @@ inline uint32_t fixmath_hash(uint16_t rounds) {
         uint32_t v[4] = {any(s), any(s), 0, any(s) >> (xorshift(s) & 7)};
         h.add(sum_squares(v, 4));
         h.add(div32_16(any(s), static_cast<uint16_t>((any(s) & 0xFFFF) | 1)));
+        // Zeros and equal exponents.
+        Num z(0), w = x;
+        w.e = y.e;
+        h.add(static_cast<uint32_t>(z.cmp(x)) ^ static_cast<uint32_t>(x.cmp(z)) << 8 ^
+              static_cast<uint32_t>(z.cmp(z)) << 16 ^ static_cast<uint32_t>(w.cmp(y)) << 24);
+        Num u = z, v2 = x;
+        h.add(u.add(x));
+        h.add(v2.add(z));
+        h.add(w.add(y));
+        h.add(z.mul(x));
+        h.add(Num(x).div(z));
     }
     return h.h;
 }
