@@ -283,7 +283,9 @@ uint32_t sqrt_step(uint32_t rem, uint16_t s) {
         }
     }
 #endif
-    return static_cast<uint32_t>(q0) << 15 | q;
+    uint32_t out = q;
+    if (q0) out += q0 == 1 ? 0x8000ul : 0x10000ul; // q0 << 15 without a 15-turn shift loop
+    return out;
 }
 
 } // namespace
@@ -568,9 +570,16 @@ Num& Num::sqrt() {
     // one unit of sqrt(v) * 2^16 (2^-31 relative). It reaches 2^32 just below v = 2^32.
     uint32_t rem;
     uint16_t s = isqrt_rem(v, rem);
-    uint32_t next = (static_cast<uint32_t>(s) << 16) + sqrt_step(rem, s);
-    if (next < (static_cast<uint32_t>(s) << 16)) return set(1, static_cast<int8_t>(ex / 2 + 16));
-    return set(next, static_cast<int8_t>(ex / 2 - 16));
+    uint32_t top = static_cast<uint32_t>(s) << 16; // >= 2^31: the result is normalised
+    uint32_t next = top + sqrt_step(rem, s);
+    ex = static_cast<int8_t>((ex >> 1) - 16); // ex is even
+    if (next < top) { // 2^32
+        next = 0x80000000ul;
+        ++ex;
+    }
+    m = next;
+    e = ex;
+    return *this;
 }
 
 Num sum_squares(const uint32_t v[], uint8_t n) {
