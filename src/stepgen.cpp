@@ -42,13 +42,17 @@ bool StepGen::begin(const MoveSpec& spec) {
         ln_.g.m = 0;
         return false;
     }
-    take_spec(spec);
     line_start(ln_.g, ln_.c);
     build_k_table(spec.group);
+    return start_profile(spec, ln_.g.dist[0]);
+}
+
+bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
+    take_spec(spec);
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
-    prepare_profile(entry, spec.v_exit2, ln_.g.dist[0]);
+    prepare_profile(entry, spec.v_exit2, ticks);
     if (holding_) {
         a_hold_ = prof_.a_entry;
         x2_hold_ = 0;
@@ -150,23 +154,11 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
                                   : cv_.w.bezier(e, centre, other);
     if (!ok) return false;
     curve_ = &c;
-    take_spec(spec);
     // The profile's reference axis is a virtual one with 1000 ticks per mm (µm) along the path.
-    cv_.ref_um = len_q8_ >> 8;
+    cv_.ref_um = spec.len_q8 >> 8;
     if (cv_.ref_um == 0) cv_.ref_um = 1;
     cv_.x_q8 = 0;
-    uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
-    have_handover_ = false;
-    origin_ = 0;
-    prepare_profile(entry, spec.v_exit2, cv_.ref_um);
-    if (holding_) {
-        a_hold_ = prof_.a_entry;
-        x2_hold_ = 0;
-    }
-    active_ = true;
-    stopped_ = false;
-    seg_len_ = 1;
-    return true;
+    return start_profile(spec, cv_.ref_um);
 }
 
 void StepGen::take_spec(const MoveSpec& spec) {
