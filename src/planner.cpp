@@ -42,19 +42,6 @@ uint8_t tightest(const Settings& s, Limit which, const uint32_t comp[kAxes]) {
     return best;
 }
 
-// min over axes with comp[a] > 0 of lim[a] / comp[a], times `scale`: the largest value along a
-// direction that keeps every axis within its own limit (GRBL's limit_value_by_axis_maximum).
-// The bounding axis is found by exact comparisons, so there is one division.
-uint32_t limit_along(const Settings& s, Limit which, const uint32_t comp[kAxes], Num scale) {
-    uint8_t a = tightest(s, which, comp);
-    if (a == kAxes) return 0xFFFFFFFFul;
-    Num best(axis_limit(s, a, which));
-    best.div(comp[a]);
-    if (which == kAccel) scale.mulc(k3_6, k3_6e); // units/s^2 x1000 -> units/min^2
-    uint32_t v = best.mul(scale).u32();
-    return v ? v : 1;
-}
-
 // Euclidean norm of kAxes 32-bit components.
 Num norm(const uint32_t v[kAxes]) {
     return sum_squares(v, kAxes).sqrt();
@@ -154,12 +141,12 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     eps.e = -52;
     if (q.cmp(eps) <= 0) return 0xFFFFFFFFul;
     // Only min(junction, limit) matters. With p = 1 - q = sin^2 <= 1, sin (1 + sin) >= p >= 1/2
-    // when q <= 1/2, and the junction acceleration (limited per axis along d) is at least the
-    // smallest axis acceleration of d, so
+    // when q < 1/2 (q.e < -32), and the junction acceleration (limited per axis along d) is at
+    // least the smallest axis acceleration of d, so
     //   v_junction^2 >= a_min x 3.6 x delta / (2000 q) >= limit  when  a_min delta >= 1024 q limit
     // (a margin of 1.8 over every truncation below): then the junction does not limit.
     // Nearly straight chains of short segments (the common case) stop here.
-    if (q.cmp(Num(1, -1)) <= 0) {
+    if (q.e < -32) {
         Num lhs(a_min);
         Num rhs(limit);
         if (lhs.mul(m_->junction_dev_um).cmp(rhs.mul(q).shift(10)) >= 0) return 0xFFFFFFFFul;
@@ -172,10 +159,14 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     p.set(~p.shift(32).u32(), -32);
     if (p.cmp(eps) <= 0) return 0;
     Num sin_half = p.sqrt();
-    // Acceleration along the junction vector d, limited per axis; delta in µm / 1000.
-    uint32_t ja = limit_along(s, kAccel, dc, dn);
+    // Acceleration along the junction vector d, limited per axis (GRBL's
+    // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
+    // x1000 -> units/min^2: x 3.6), at least 1; delta in µm / 1000.
+    uint8_t a = tightest(s, kAccel, dc);
+    Num ja(s.axis[a].accel);
+    uint32_t ja_u = ja.div(dc[a]).mul(dn.mulc(k3_6, k3_6e)).u32();
     Num r(1);
-    r.add(sin_half).mul(sin_half).div(q).mul(ja).mul(m_->junction_dev_um);
+    r.add(sin_half).mul(sin_half).div(q).mul(ja_u ? ja_u : 1).mul(m_->junction_dev_um);
     return r.mulc(kMilli, -41).u32(); // / 1000
 }
 
