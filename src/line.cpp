@@ -9,11 +9,12 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     g.dirs = 0;
     // §7.1: drop still axes, insertion-sort the rest by distance, decreasing. Ties keep the
     // machine-axis order so that the result is deterministic.
-    for (uint8_t a = 0; a < kAxes; ++a) {
+    uint8_t bit = 1;
+    for (uint8_t a = 0; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         int32_t d = delta[a];
         if (d == 0) continue;
         uint32_t dist = d < 0 ? static_cast<uint32_t>(-(d + 1)) + 1u : static_cast<uint32_t>(d);
-        if (d < 0) g.dirs = static_cast<uint8_t>(g.dirs | (1u << a));
+        if (d < 0) g.dirs = static_cast<uint8_t>(g.dirs | bit);
         uint8_t i = g.m;
         while (i > 0 && g.dist[i - 1] < dist) {
             g.dist[i] = g.dist[i - 1];
@@ -29,7 +30,7 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     // §7.2: P = 2^k, the smallest power of two with P >= 8 d_1.
     uint32_t d1 = g.dist[0];
     uint8_t k = 3;
-    while ((1ul << k) < 8ul * d1) ++k;
+    for (uint32_t p = 8; p < 8ul * d1; p <<= 1) ++k; // not 1 << k: a shift loop per turn
     g.shift = k;
     g.slope[0] = 1ul << kLineUnit;
     for (uint8_t j = 1; j < g.m; ++j) {

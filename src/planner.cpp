@@ -55,9 +55,9 @@ namespace {
 // Euclidean over the move's group (seed §3.1), at least 1.
 uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uint32_t x[kAxes]) {
     uint32_t xg[kAxes];
-    for (uint8_t a = 0; a < kAxes; ++a) {
+    for (uint8_t a = 0; a < kAxes; ++a, group >>= 1) { // bit a of group in bit 0
         x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
-        xg[a] = (group & (1u << a)) ? x[a] : 0;
+        xg[a] = (group & 1) ? x[a] : 0;
     }
     uint32_t len = norm(xg).u32();
     return len ? len : 1;
@@ -178,12 +178,12 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     uint32_t xu[kAxes]; // |commanded travel| (µm) on the regulated axes, then the unit vector
     uint8_t neg = 0;    // axes whose commanded travel is negative
     bool moves = false;
-    for (uint8_t a = 0; a < kAxes; ++a) {
+    for (uint8_t a = 0, bit = 1; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         d[a] = target[a] - last_[a];
         if (d[a] != 0) moves = true;
         int32_t du = target_um[a] - last_um_[a];
         last_um_[a] = target_um[a];
-        if (du < 0) neg = static_cast<uint8_t>(neg | (1u << a));
+        if (du < 0) neg = static_cast<uint8_t>(neg | bit);
         xu[a] = abs32(du);
     }
     if (!moves) return false;
@@ -208,16 +208,17 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     }
 
     // Unit vector of the commanded move (Q29), for the junction, in place of xu.
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        if (!(group & (1u << a))) xu[a] = 0;
+    uint8_t in_group = group;
+    for (uint8_t a = 0; a < kAxes; ++a, in_group >>= 1) {
+        if (!(in_group & 1)) xu[a] = 0;
     }
     Num to_unit(1, 29);
     to_unit.div(norm(xu));
     int32_t* unit = reinterpret_cast<int32_t*>(xu);
-    for (uint8_t a = 0; a < kAxes; ++a) {
+    for (uint8_t a = 0; a < kAxes; ++a, neg >>= 1) {
         uint32_t u = to_unit.of(xu[a]);
         if (u > (1ul << 29)) u = 1ul << 29;
-        unit[a] = (neg & (1u << a)) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+        unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
     // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
     uint32_t limit = count_ > 0 ? speed2_of(min32(b.feed, ring_[index(count_ - 1)].feed)) : 0;

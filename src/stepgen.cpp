@@ -68,8 +68,9 @@ void StepGen::build_k_table(uint8_t group) {
     const uint8_t sets = static_cast<uint8_t>(1u << (m - 1));
     for (uint8_t sub = 0; sub < sets; ++sub) {
         uint8_t mask = static_cast<uint8_t>(1u << ln_.g.axis[0]);
-        for (uint8_t j = 1; j < m; ++j) {
-            if (sub & (1u << (j - 1))) mask = static_cast<uint8_t>(mask | (1u << ln_.g.axis[j]));
+        uint8_t bits = sub; // sorted position j in bit j - 1
+        for (uint8_t j = 1; j < m; ++j, bits >>= 1) {
+            if (bits & 1) mask = static_cast<uint8_t>(mask | (1u << ln_.g.axis[j]));
         }
         ln_.mask[sub] = mask;
     }
@@ -274,7 +275,7 @@ void StepGen::pushed_position(int32_t out[kAxes]) const {
     for (uint8_t j = 0; j < ln_.g.m; ++j) {
         uint8_t a = ln_.g.axis[j];
         int32_t p = static_cast<int32_t>(ln_.c.pos[j]);
-        out[a] += (ln_.g.dirs & (1u << a)) ? -p : p;
+        out[a] += ((ln_.g.dirs >> a) & 1) ? -p : p;
     }
 }
 
