@@ -93,9 +93,9 @@ void StepGen::build_k_table(uint8_t group) {
     }
     lens_valid_ = true;
     uint32_t sum_hi = 0, sum_lo = 0, count_g = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
-    for (uint8_t i = 0; i < m; ++i) {
+    for (uint8_t i = 0, set = 0; i < m; ++i, set = static_cast<uint8_t>(2 * set + 1)) {
         uint32_t n = ln_.g.dist[i] - (i + 1 < m ? ln_.g.dist[i + 1] : 0);
-        uint32_t len = lens[(1u << i) - 1];
+        uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
         if (len != 0 && n != 0) {
             uint32_t lo, hi = mul_wide(n, len, lo);
             sum_lo += lo;
@@ -464,10 +464,10 @@ void StepGen::fill_curve(RunQueue& q) {
             uint8_t moved, neg;
             if (!cv_.w.next(moved, neg)) break;
             uint8_t steps = 0, dirs = 0;
-            for (uint8_t k = 0; k < 3; ++k) {
+            for (uint8_t k = 0; k < 3; ++k, moved >>= 1, neg >>= 1) {
                 uint8_t bit = static_cast<uint8_t>(1u << cv_.axes[k]);
-                if (moved & (1u << k)) steps = static_cast<uint8_t>(steps | bit);
-                if (neg & (1u << k)) dirs = static_cast<uint8_t>(dirs | bit);
+                if (moved & 1) steps = static_cast<uint8_t>(steps | bit);
+                if (neg & 1) dirs = static_cast<uint8_t>(dirs | bit);
             }
             if (run_count != 0 && (steps != run_steps || (steps && dirs != run_dirs))) {
                 emit(q, run_steps, run_dirs, run_count, period_q8);
