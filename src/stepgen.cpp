@@ -309,6 +309,16 @@ void StepGen::clear_queue_time() {
     seen_head_ = 0;
 }
 
+void StepGen::push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint16_t period,
+                   uint8_t units) {
+    slot_time_[q.tail] = units;
+    queued_ = static_cast<uint16_t>(queued_ + units);
+    q.push(Run{steps, dirs, count, period});
+#if LL_STATS
+    ++stats.runs;
+#endif
+}
+
 void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8) {
     uint32_t period = period_q8 > 0xFFFFFF7Ful ? 0xFFFFFFul : (period_q8 + 128) >> 8;
     if (period < min_period_) {
@@ -321,12 +331,8 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
     if (period <= 0xFFFF) {
         // >> 10 as a byte move and two shifts (avr-gcc 5.4 makes a 10-turn loop of it)
         uint32_t units = ((count == 1 ? period : period * count) >> 8) >> 2; // < 2^14
-        slot_time_[q.tail] = units > 255 ? 255 : static_cast<uint8_t>(units);
-        queued_ = static_cast<uint16_t>(queued_ + slot_time_[q.tail]);
-        q.push(Run{steps, dirs, count, static_cast<uint16_t>(period)});
-#if LL_STATS
-        ++stats.runs;
-#endif
+        push(q, steps, dirs, count, static_cast<uint16_t>(period),
+             units > 255 ? 255 : static_cast<uint8_t>(units));
     } else {
         // Below 245 steps/s: each event is preceded by idle waits (steps == 0) so that every
         // compare value fits the 16-bit timer without changing its prescaler.
@@ -334,14 +340,8 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
         uint16_t each = static_cast<uint16_t>(period / parts);
         uint16_t last = static_cast<uint16_t>(period - (parts - 1) * each);
         for (uint8_t i = 0; i < count; ++i) {
-            slot_time_[q.tail] = 255;
-            q.push(Run{0, dirs, static_cast<uint8_t>(parts - 1), each});
-            slot_time_[q.tail] = 63;
-            q.push(Run{steps, dirs, 1, last});
-            queued_ = static_cast<uint16_t>(queued_ + 255 + 63);
-#if LL_STATS
-            stats.runs += 2;
-#endif
+            push(q, 0, dirs, static_cast<uint8_t>(parts - 1), each, 255);
+            push(q, steps, dirs, 1, last, 63);
         }
     }
 }

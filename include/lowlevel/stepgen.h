@@ -142,6 +142,9 @@ class StepGen {
     /// Sets x2_decel_ and cruising_ from prof_.
     void mark_profile();
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
+    /// Queues one run and counts its duration (1024-cycle units) in the horizon.
+    void push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint16_t period,
+              uint8_t units);
     /// Delta_1 (cycles x 256 per reference unit) at half-unit position x2; false when a hold
     /// brings the speed to zero before x2.
     bool delta_at(uint32_t x2, uint32_t& delta);
