@@ -351,7 +351,8 @@ int32_t mul_q30(int32_t a, int32_t b) {
     uint32_t lo, hi = mul64(ua, ub, lo);
     if (a < 0) hi -= ub;
     if (b < 0) hi -= ua;
-    return static_cast<int32_t>(hi << 2 | lo >> 30);
+    uint8_t top = static_cast<uint8_t>(lo >> 24); // lo >> 30 without a 30-turn shift loop
+    return static_cast<int32_t>(hi << 2 | static_cast<uint8_t>(top >> 6));
 }
 
 // 1 - x * r * t in Q30, with r a Q30 reciprocal constant: one step of a Horner series.

@@ -179,7 +179,6 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     //   d_1^2;
     // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD len_q8 sqrt(psi),
     //   kD = 2 kSqrtCHalf / sqrt(2^7 128000).
-    uint32_t lo, hi;
     Num psi(d1);
     psi.mul(dv2_);
     {
@@ -187,8 +186,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
         psi = one.div(psi);
     }
     Num phi = psi;
-    hi = mul_wide(d1, d1, lo);
-    phi.mul(num64(hi, lo));
+    phi.mul(d1).mul(d1);
     Num dn = psi;
     dn.sqrt().mul(Num(len_q8_)).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
@@ -210,8 +208,8 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
-    hi = mul_wide(feed_, d1, lo);
-    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(num64(hi, lo)).u32();
+    Num fd(feed_);
+    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(fd.mul(d1)).u32();
     mark_profile();
     root_valid_ = false;
     if (!curve_) {
