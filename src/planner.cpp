@@ -42,6 +42,11 @@ uint8_t tightest(const Settings& s, Limit which, const uint32_t comp[kAxes]) {
     return best;
 }
 
+// x <= 5e-7 (GRBL's junction thresholds): 5e-7 = kMicro 2^-52.
+bool tiny(const Num& x) {
+    return x.m == 0 || x.e < -52 || (x.e == -52 && x.m <= kMicro);
+}
+
 // Euclidean norm of kAxes 32-bit components.
 Num norm(const uint32_t v[kAxes]) {
     return sum_squares(v, kAxes).sqrt();
@@ -136,10 +141,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     q.shift(-60);
     // GRBL's thresholds: |cos theta| > 0.999999 is straight on (no limit) or a reversal
     // (stop), i.e. q or p below 5e-7.
-    Num eps;
-    eps.m = kMicro; // 5e-7
-    eps.e = -52;
-    if (q.cmp(eps) <= 0) return 0xFFFFFFFFul;
+    if (tiny(q)) return 0xFFFFFFFFul;
     // Only min(junction, limit) matters. With p = 1 - q = sin^2 <= 1, sin (1 + sin) >= p >= 1/2
     // when q < 1/2 (q.e < -32), and the junction acceleration (limited per axis along d) is at
     // least the smallest axis acceleration of d, so
@@ -157,7 +159,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // 5e-7 threshold, where v_junction^2 is a few (mm/min)^2, well within a unit.
     Num p = q;
     p.set(~p.shift(32).u32(), -32);
-    if (p.cmp(eps) <= 0) return 0;
+    if (tiny(p)) return 0;
     Num sin_half = p.sqrt();
     // Acceleration along the junction vector d, limited per axis (GRBL's
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
