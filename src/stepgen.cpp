@@ -293,13 +293,19 @@ void StepGen::abort() {
 }
 
 uint32_t StepGen::queued_cycles(const RunQueue& q) {
+    horizon_full(q);
+    return static_cast<uint32_t>(queued_) << 10;
+}
+
+bool StepGen::horizon_full(const RunQueue& q) {
     // Runs the interrupt has taken since the last look no longer count.
     uint8_t head = q.head;
     while (seen_head_ != head) {
         queued_ = static_cast<uint16_t>(queued_ - slot_time_[seen_head_]);
         seen_head_ = static_cast<uint8_t>((seen_head_ + 1) & (kRunQueueSize - 1));
     }
-    return static_cast<uint32_t>(queued_) << 10;
+    // queued_cycles() >= kHorizonCycles, in the 1024-cycle units (no 32-bit shift)
+    return queued_ >= (kHorizonCycles + 1023) >> 10;
 }
 
 void StepGen::clear_queue_time() {
@@ -406,7 +412,7 @@ void StepGen::fill_line(RunQueue& q) {
         // Room for the worst case of one segment: m runs, each possibly split in two; and no
         // more than the horizon committed ahead of the interrupt.
         if (q.free_slots() < 2 * ln_.g.m) break;
-        if (queued_cycles(q) >= kHorizonCycles) break;
+        if (horizon_full(q)) break;
         uint32_t left = ln_.g.dist[0] - ln_.c.x1;
         uint8_t len = left < seg_len_ ? static_cast<uint8_t>(left) : seg_len_;
         uint32_t delta;
@@ -434,7 +440,7 @@ void StepGen::fill_curve(RunQueue& q) {
     while (active_ && !stopped_) {
         // Worst case of one segment: every sample its own run, each possibly split in two.
         if (q.free_slots() < 2 * kMaxSegmentTicks + 2) break;
-        if (queued_cycles(q) >= kHorizonCycles) break;
+        if (horizon_full(q)) break;
         // The chord of the next sample sets the time of every sample of the segment (the
         // segment never crosses into the next piece, whose samples may be twice as long).
         int32_t d[3];

@@ -142,6 +142,8 @@ class StepGen {
     /// Sets x2_decel_ and cruising_ from prof_.
     void mark_profile();
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
+    /// queued_cycles(q) >= kHorizonCycles.
+    bool horizon_full(const RunQueue& q);
     /// Queues one run and counts its duration (1024-cycle units) in the horizon.
     void push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint16_t period,
               uint8_t units);
