@@ -583,7 +583,7 @@ Num& Num::sqrt() {
     return *this;
 }
 
-Num sum_squares(const uint32_t v[], uint8_t n) {
+Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask) {
     // Exact 64-bit sums while every value is below 2^30 (6 squares below 2^63); larger values
     // (travel beyond 4 km) lose their two low bits first.
     uint8_t drop = 0;
@@ -591,9 +591,9 @@ Num sum_squares(const uint32_t v[], uint8_t n) {
         if (static_cast<uint8_t>(v[i] >> 24) >= 0x40) drop = 2;
     }
     uint32_t hi = 0, lo = 0;
-    for (uint8_t i = 0; i < n; ++i) {
+    for (uint8_t i = 0; i < n; ++i, mask >>= 1) {
         uint32_t x = v[i];
-        if (x == 0) continue;
+        if (x == 0 || !(mask & 1)) continue;
         if (drop) x >>= 2;
         uint32_t l, h = mul64(x, x, l);
         lo += l;

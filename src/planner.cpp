@@ -59,12 +59,8 @@ namespace {
 // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated length:
 // Euclidean over the move's group (seed §3.1), at least 1.
 uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uint32_t x[kAxes]) {
-    uint32_t xg[kAxes];
-    for (uint8_t a = 0; a < kAxes; ++a, group >>= 1) { // bit a of group in bit 0
-        x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
-        xg[a] = (group & 1) ? x[a] : 0;
-    }
-    uint32_t len = norm(xg).u32();
+    for (uint8_t a = 0; a < kAxes; ++a) x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
+    uint32_t len = sum_squares(x, kAxes, group).sqrt().u32();
     return len ? len : 1;
 }
 
@@ -153,52 +149,53 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
         Num rhs(limit);
         if (lhs.mul(m_->junction_dev_um).cmp(rhs.mul(q).shift(10)) >= 0) return 0xFFFFFFFFul;
     }
-    Num dn = q;
-    dn.sqrt().shift(30); // |d| in Q29: sqrt(q) * 2 * 2^29
+    // The exact formula (rare in chains of short segments).
     // p = 1 - q to 2^-32: near a reversal (p small) its relative error grows to 2^-11 at the
     // 5e-7 threshold, where v_junction^2 is a few (mm/min)^2, well within a unit.
-    Num p = q;
-    p.set(~p.shift(32).u32(), -32);
-    if (tiny(p)) return 0;
-    Num sin_half = p.sqrt();
+    Num t = q;
+    t.set(~t.shift(32).u32(), -32);
+    if (tiny(t)) return 0;
+    Num r(1);
+    t.sqrt(); // sin(theta / 2)
+    r.add(t).mul(t).div(q); // (1 + sin) sin / q
     // Acceleration along the junction vector d, limited per axis (GRBL's
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
-    // x1000 -> units/min^2: x 3.6), at least 1; delta in µm / 1000.
+    // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
+    // 1000.
     uint8_t a = tightest(s, kAccel, dc);
-    Num ja(s.axis[a].accel);
-    uint32_t ja_u = ja.div(dc[a]).mul(dn.mulc(k3_6, k3_6e)).u32();
-    Num r(1);
-    r.add(sin_half).mul(sin_half).div(q).mul(ja_u ? ja_u : 1).mul(m_->junction_dev_um);
+    t = q;
+    t.sqrt().shift(30).mulc(k3_6, k3_6e);
+    uint32_t ja = Num(s.axis[a].accel).div(dc[a]).mul(t).u32();
+    r.mul(ja ? ja : 1).mul(m_->junction_dev_um);
     return r.mulc(kMilli, -41).u32(); // / 1000
 }
 
 bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                   bool rapid) {
-    // Few locals: the ATmega328P addresses only 64 bytes of a stack frame directly.
+    // Few locals, in scopes that do not overlap (they share their stack slots): the deepest
+    // stack of the firmware runs through here.
     PlanBlock& b = ring_[index(count_)];
-    int32_t d[kAxes];
-    uint32_t xu[kAxes]; // |commanded travel| (µm) on the regulated axes, then the unit vector
-    uint8_t neg = 0;    // axes whose commanded travel is negative
-    bool moves = false;
-    for (uint8_t a = 0, bit = 1; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
-        d[a] = target[a] - last_[a];
-        if (d[a] != 0) moves = true;
-        int32_t du = target_um[a] - last_um_[a];
-        last_um_[a] = target_um[a];
-        if (du < 0) neg = static_cast<uint8_t>(neg | bit);
-        xu[a] = abs32(du);
-    }
-    if (!moves) return false;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        last_[a] = target[a];
-        uint32_t v = static_cast<uint32_t>(d[a]);
-        b.delta[a][0] = static_cast<uint8_t>(v);
-        b.delta[a][1] = static_cast<uint8_t>(v >> 8);
-        b.delta[a][2] = static_cast<uint8_t>(v >> 16);
-    }
-    const uint8_t group = regulated_group(*m_, d);
-    b.group = group;
+    uint8_t group;
     {
+        int32_t d[kAxes];
+        bool moves = false;
+        for (uint8_t a = 0; a < kAxes; ++a) {
+            d[a] = target[a] - last_[a];
+            if (d[a] != 0) moves = true;
+        }
+        if (!moves) {
+            for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
+            return false;
+        }
+        for (uint8_t a = 0; a < kAxes; ++a) {
+            last_[a] = target[a];
+            uint32_t v = static_cast<uint32_t>(d[a]);
+            b.delta[a][0] = static_cast<uint8_t>(v);
+            b.delta[a][1] = static_cast<uint8_t>(v >> 8);
+            b.delta[a][2] = static_cast<uint8_t>(v >> 16);
+        }
+        group = regulated_group(*m_, d);
+        b.group = group;
         MoveLimits lim;
         move_limits(*m_, d, group, lim);
         b.len_q8 = lim.len_q8;
@@ -209,10 +206,17 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         b.dv2 = num64(hi, lo).mulc(kMilli, -48).u32();
     }
 
-    // Unit vector of the commanded move (Q29), for the junction, in place of xu.
+    // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
+    // first, then the unit vector in its place.
+    uint32_t xu[kAxes];
+    uint8_t neg = 0; // axes whose commanded travel is negative
     uint8_t in_group = group;
-    for (uint8_t a = 0; a < kAxes; ++a, in_group >>= 1) {
-        if (!(in_group & 1)) xu[a] = 0;
+    for (uint8_t a = 0, bit = 1; a < kAxes;
+         ++a, bit = static_cast<uint8_t>(bit << 1), in_group >>= 1) {
+        int32_t du = target_um[a] - last_um_[a];
+        last_um_[a] = target_um[a];
+        if (du < 0) neg = static_cast<uint8_t>(neg | bit);
+        xu[a] = (in_group & 1) ? abs32(du) : 0;
     }
     Num to_unit(1, 29);
     to_unit.div(norm(xu));

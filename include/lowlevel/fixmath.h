@@ -62,9 +62,10 @@ int32_t atan2_q29(int32_t y, int32_t x);
 /// 2^-30 (no table): used where an arc is prepared, never per step.
 void small_angle_q30(int32_t h, int32_t& c, int32_t& s, int32_t& k);
 
-/// Sum of the squares of n values as a Num (exact 64-bit sums; truncated to 32 bits once).
+/// Sum of the squares of the n values whose bit is set in `mask` (bit i for v[i]), as a Num
+/// (exact 64-bit sums; truncated to 32 bits once).
 struct Num;
-Num sum_squares(const uint32_t v[], uint8_t n);
+Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask = 0xFF);
 /// (hi * 2^32 + lo) * 2^exp as a Num, truncated; exp <= 95.
 Num num64(uint32_t hi, uint32_t lo, int8_t exp = 0);
 
