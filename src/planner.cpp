@@ -238,25 +238,38 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     return true;
 }
 
-void Planner::recalculate() {
-    // Pointer walks (an index modulo the ring and a 29-byte stride per block cost more than the
+void Planner::recalculate(bool all) {
+    // Pointer walks (an index modulo the ring and a 33-byte stride per block cost more than the
     // passes themselves on the ATmega328P).
     PlanBlock* const first = ring_;
     PlanBlock* const last = ring_ + (kPlannerSize - 1);
     // Backward pass: each move must be able to slow down to the next one's entry (0 after the
     // last move). The move being executed keeps its entry speed.
+    // A new move only raises what the moves before it may reach. Once a move's entry comes out
+    // at its maximum and was already there (the forward pass only lowers), every earlier move
+    // keeps its entry: the passes stop there (in a chain of short moves, a few moves from the
+    // end instead of the whole ring). Only while the oldest move is being executed: its entry
+    // is then fixed, as it was at the last pass; otherwise it is recomputed from scratch.
     PlanBlock* b = &ring_[index(static_cast<uint8_t>(count_ - 1))];
     uint32_t next_entry = 0;
-    for (uint8_t n = static_cast<uint8_t>(count_ - first_begun_); n != 0; --n) {
+    uint8_t pos = count_;
+    uint8_t from = 0; // where the forward pass starts
+    while (pos-- > first_begun_) {
         uint32_t v = add_sat(next_entry, b->dv2);
-        if (v > b->v_max_entry2) v = b->v_max_entry2;
+        if (v >= b->v_max_entry2) {
+            v = b->v_max_entry2;
+            if (!all && first_begun_ && b->v_entry2 == v) {
+                from = pos;
+                break;
+            }
+        }
         b->v_entry2 = v;
         next_entry = v;
         b = b == first ? last : b - 1;
     }
     // Forward pass: no move can enter faster than the previous one can accelerate to.
-    b = &ring_[head_];
-    for (uint8_t n = count_; n > 1; --n) {
+    b = &ring_[index(from)];
+    for (uint8_t n = static_cast<uint8_t>(count_ - from); n > 1; --n) {
         uint32_t reach = add_sat(b->v_entry2, b->dv2);
         b = b == last ? first : b + 1;
         if (b->v_entry2 > reach) b->v_entry2 = reach;
@@ -302,7 +315,7 @@ void Planner::restart_first(uint32_t remaining, uint32_t total) {
     if (total != 0) b.dv2 = Num(remaining).div(total).of(b.dv2);
     b.v_entry2 = 0;
     first_begun_ = 1;
-    recalculate();
+    recalculate(true);
 }
 
 } // namespace ll

@@ -77,7 +77,8 @@ class Planner {
 
   private:
     uint8_t index(uint8_t i) const { return static_cast<uint8_t>((head_ + i) % kPlannerSize); }
-    void recalculate();
+    /// The look-ahead passes; `all`: do not stop where nothing changes (after a restart).
+    void recalculate(bool all = false);
     /// Junction speed squared with the previous move, or any value >= `limit` when it is at
     /// least that (the caller takes the minimum).
     uint32_t junction2(const int32_t unit[kAxes], uint32_t limit) const;
