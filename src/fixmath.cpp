@@ -323,10 +323,12 @@ uint32_t shr64_sat(uint32_t hi, uint32_t lo, uint8_t shift) {
     return shr_sat(hi, lo, shift);
 }
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift) {
     uint32_t lo, hi = mul64(a, b, lo);
     return shr_sat(hi, lo, shift);
 }
+#endif
 
 uint32_t shl_sat(uint32_t x, uint8_t k) {
     // A bit at a time: the shifts are small where it matters (the speed profile, k < 9), and a
