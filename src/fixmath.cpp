@@ -508,9 +508,11 @@ Num& Num::mulc(uint32_t mant, int8_t exp) {
     return mul(c);
 }
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::mul(uint32_t v) {
     return mul(Num(v));
 }
+#endif
 
 #if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::div(const Num& o) {
@@ -532,9 +534,11 @@ Num& Num::div(const Num& o) {
 }
 #endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::div(uint32_t v) {
     return div(Num(v));
 }
+#endif
 
 #if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::add(const Num& o) {

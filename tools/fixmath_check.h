@@ -86,6 +86,9 @@ inline uint32_t fixmath_hash(uint16_t rounds) {
         h.add(w.add(y));
         h.add(z.mul(x));
         h.add(Num(x).div(z));
+        h.add(Num(x).mul(b));
+        h.add(Num(y).mul(b >> (xorshift(s) & 31)));
+        h.add(Num(y).div(a >> (xorshift(s) & 31)));
     }
     return h.h;
 }
