@@ -629,12 +629,14 @@ uint32_t Num::u32() const {
 }
 #endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 uint32_t Num::of(uint32_t x) const {
     // floor(x * m * 2^e), from the exact 64-bit product.
     if (m == 0 || x == 0 || e <= -64) return 0;
     if (e > 0) return 0xFFFFFFFFul;
     return mul_shr(x, m, static_cast<uint8_t>(-e));
 }
+#endif
 
 #if !defined(__AVR__) // AVR: fixmath_avr.cpp
 int8_t Num::cmp(const Num& o) const {

@@ -709,6 +709,50 @@ asm(".section .text._ZNK2ll3Num3cmpERKS0_,\"ax\",@progbits\n"
 // in r16 (call-saved: read only). The 64-bit product (__ll_mul32), shifted by whole bytes,
 // then bit by bit on the five bytes that matter; saturated when anything is left above them.
 asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
+    // uint32_t Num::of(uint32_t x) const: this in r24:r25, x in r20..r23. floor(x m 2^e):
+    // 0 below 2^-64 or for a zero operand, saturated for e > 0, else mul_shr(x, m, -e).
+    ".global _ZNK2ll3Num2ofEm\n"
+    ".type _ZNK2ll3Num2ofEm, @function\n"
+    "_ZNK2ll3Num2ofEm:\n"
+    "movw r30, r24\n"
+    "ldd  r26, Z+4\n" // e
+    "mov  r27, r20\n"
+    "or   r27, r21\n"
+    "or   r27, r22\n"
+    "or   r27, r23\n"
+    "breq .Lof_zero\n" // x == 0
+    "ldd  r27, Z+3\n"
+    "tst  r27\n"
+    "breq .Lof_zero\n" // m == 0 (normalised: by its top byte)
+    "cpi  r26, 1\n"
+    "brge .Lof_sat\n" // e > 0: x m 2^e >= 2^32
+    "cpi  r26, 0xC1\n"
+    "brlt .Lof_zero\n" // e <= -64
+    "movw r24, r22\n"  // a = x
+    "movw r22, r20\n"
+    "ld   r18, Z\n" // b = m
+    "ldd  r19, Z+1\n"
+    "ldd  r20, Z+2\n"
+    "ldd  r21, Z+3\n"
+    "neg  r26\n"
+    "push r13\n"
+    "push r14\n"
+    "push r15\n"
+    "push r16\n"
+    "push r17\n"
+    "mov  r13, r26\n"
+    "rjmp .Lmul_shr_go\n"
+    ".Lof_sat:\n"
+    "ldi  r22, 0xFF\n"
+    "ldi  r23, 0xFF\n"
+    "movw r24, r22\n"
+    "ret\n"
+    ".Lof_zero:\n"
+    "clr  r22\n"
+    "clr  r23\n"
+    "movw r24, r22\n"
+    "ret\n"
+    ".size _ZNK2ll3Num2ofEm, .-_ZNK2ll3Num2ofEm\n"
     ".global _ZN2ll7mul_shrEmmh\n"
     ".type _ZN2ll7mul_shrEmmh, @function\n"
     "_ZN2ll7mul_shrEmmh:\n"
@@ -718,6 +762,7 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "push r16\n"
     "push r17\n"
     "mov  r13, r16\n"
+    ".Lmul_shr_go:\n"
     "call __ll_mul32\n" // lo r18..r21, hi r22..r25
     "mov  r30, r13\n"
     "1:\n"

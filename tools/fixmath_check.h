@@ -87,6 +87,8 @@ inline uint32_t fixmath_hash(uint16_t rounds) {
         h.add(z.mul(x));
         h.add(Num(x).div(z));
         h.add(Num(x).mul(b));
+        h.add(Num(a | 1, static_cast<int8_t>(-40 - static_cast<int8_t>(xorshift(s) & 31))).of(b));
+        h.add(z.of(b) ^ x.of(0));
         h.add(Num(y).mul(b >> (xorshift(s) & 31)));
         h.add(Num(y).div(a >> (xorshift(s) & 31)));
     }
