@@ -38,29 +38,15 @@ void begin_next(Motion& m) {
     }
 }
 
-void produce(Motion& m, uint8_t segments = 0xFF) {
+void produce(Motion& m) {
     for (;;) {
         begin_next(m);
         if (!m.begun) return;
         m.gen.set_exit(m.planner.exit2_of_first());
-        m.gen.fill(g_runs, segments);
+        m.gen.fill(g_runs);
         if (m.gen.active() || m.gen.stopped()) return; // queue full, or held
         m.planner.discard_first();
         m.begun = false;
-    }
-}
-
-void enable(Motion& m, bool on);
-
-void start_if_stopped(Motion& m) {
-    if (g_exec.running) return;
-    if (g_exec.starved && (m.begun || !m.planner.empty()) && !m.gen.stopped()) {
-        g_starvations = static_cast<uint16_t>(g_starvations + 1); // dry mid-move
-    }
-    g_exec.starved = 0;
-    if (!g_runs.empty() && m.state != State::Held) {
-        enable(m, true);
-        hal::stepper_start();
     }
 }
 
@@ -140,12 +126,17 @@ void poll() {
         }
         return;
     }
-    // The step timer stopped (a job starts, or the queue ran dry): it restarts as soon as one
-    // segment is queued, not once the whole queue is full again.
-    if (!g_exec.running && g_runs.empty()) produce(m, 1);
-    start_if_stopped(m);
     produce(m);
-    start_if_stopped(m);
+    if (!g_exec.running) {
+        if (g_exec.starved && (m.begun || !m.planner.empty()) && !m.gen.stopped()) {
+            g_starvations = static_cast<uint16_t>(g_starvations + 1); // dry mid-move
+        }
+        g_exec.starved = 0;
+        if (!g_runs.empty() && m.state != State::Held) {
+            enable(m, true);
+            hal::stepper_start();
+        }
+    }
     bool drained = g_runs.empty() && !g_exec.running;
     if (m.state == State::Holding) {
         if (drained && (m.gen.stopped() || (!m.begun && m.planner.empty()))) m.state = State::Held;

@@ -407,8 +407,8 @@ void StepGen::finish_move() {
     handover_v2_ = holding_ ? speed2() : v_exit2_;
 }
 
-void StepGen::fill_line(RunQueue& q, uint8_t segments) {
-    for (; segments != 0 && active_ && !stopped_; --segments) {
+void StepGen::fill_line(RunQueue& q) {
+    while (active_ && !stopped_) {
         // Room for the worst case of one segment: m runs, each possibly split in two; and no
         // more than the horizon committed ahead of the interrupt.
         if (q.free_slots() < 2 * ln_.g.m) break;
@@ -441,8 +441,8 @@ void StepGen::fill_line(RunQueue& q, uint8_t segments) {
     }
 }
 
-void StepGen::fill_curve(RunQueue& q, uint8_t segments) {
-    for (; segments != 0 && active_ && !stopped_; --segments) {
+void StepGen::fill_curve(RunQueue& q) {
+    while (active_ && !stopped_) {
         // Worst case of one segment: every sample its own run, each possibly split in two.
         if (q.free_slots() < 2 * kMaxSegmentTicks + 2) break;
         if (horizon_full(q)) break;
@@ -498,12 +498,12 @@ void StepGen::fill_curve(RunQueue& q, uint8_t segments) {
     }
 }
 
-uint8_t StepGen::fill(RunQueue& q, uint8_t segments) {
+uint8_t StepGen::fill(RunQueue& q) {
     uint8_t pushed_before = q.used();
     if (curve_) {
-        fill_curve(q, segments);
+        fill_curve(q);
     } else {
-        fill_line(q, segments);
+        fill_line(q);
     }
     return static_cast<uint8_t>(q.used() - pushed_before);
 }

@@ -372,7 +372,6 @@ const FnList kPlannerFns = {
     {"_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "StepGen::begin"},
     {"_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE", "StepGen::fill"},
     {"_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE", "StepGen::fill"},
-    {"_ZN2ll7StepGen4fillERNS_7RunRingILh16EEEh", "StepGen::fill"},
     {"_ZN2ll3hal10serial_putEh", "hal::serial_put"},
     {"_ZN2ll3app8run_onceEv", "app::run_once (the whole main loop)"},
 };
@@ -475,8 +474,7 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
         for (const char* g :
              {"_ZN2ll6motion4pollEv", "_ZNK2ll7Planner13spec_of_firstEv",
               "_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE",
-              "_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE",
-              "_ZN2ll7StepGen4fillERNS_7RunRingILh16EEEh"}) {
+              "_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE"}) {
             const int k = prof->index_of(g);
             if (k >= 0) is_gen[static_cast<size_t>(k)] = true;
         }
@@ -637,7 +635,6 @@ std::vector<FnCost> producer_profile(const Config& cfg, double rate, double mm, 
         {"_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "StepGen::begin"},
         // The same with a 16-run queue (config.h kRunQueueSize).
         {"_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE", "StepGen::fill"},
-        {"_ZN2ll7StepGen4fillERNS_7RunRingILh16EEEh", "StepGen::fill"},
         {"_ZN2ll7StepGen4emitERNS_7RunRingILh16EEEhhhm", "StepGen::emit"},
         {"_ZN2ll7StepGen13queued_cyclesERKNS_7RunRingILh16EEE", "StepGen::queued_cycles"},
     };

@@ -75,9 +75,9 @@ class StepGen {
     bool active() const { return active_; }
 
     /// Produces segments into `q` while it has room for one more segment and holds less than
-    /// kHorizonCycles of motion, at most `segments` of them. Returns the number of runs pushed.
-    /// When the move is fully produced, active() becomes false.
-    uint8_t fill(RunQueue& q, uint8_t segments = 0xFF);
+    /// kHorizonCycles of motion. Returns the number of runs pushed. When the move is fully
+    /// produced, active() becomes false.
+    uint8_t fill(RunQueue& q);
 
     /// Motion queued ahead of the interrupt, CPU cycles (1024-cycle resolution).
     uint32_t queued_cycles(const RunQueue& q);
@@ -153,8 +153,8 @@ class StepGen {
     /// Length of the next segment, reference units: the shortest power of two lasting
     /// kSegmentCycles at `delta`, 1 when `longest` (the largest period, x 256) needs idle waits.
     static uint8_t next_segment(uint32_t delta, uint32_t longest);
-    void fill_line(RunQueue& q, uint8_t segments);
-    void fill_curve(RunQueue& q, uint8_t segments);
+    void fill_line(RunQueue& q);
+    void fill_curve(RunQueue& q);
     void finish_move();
     uint32_t ref_len() const {
         return curve_ ? cv_.ref_um : ln_.g.dist[0];
