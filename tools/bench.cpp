@@ -655,6 +655,16 @@ std::vector<FnCost> producer_profile(const Config& cfg, double rate, double mm, 
     const Trace t = trace_steps(b.sim);
     *motion_cycles = static_cast<double>(t.last() - t.first());
     std::vector<FnCost> out = costs_of(prof, fns, t0);
+    // The same function under another queue size (RunRing<16>, RunRing<32>): one row.
+    for (size_t i = 0; i < out.size(); ++i) {
+        for (size_t j = i + 1; j < out.size(); ++j) {
+            if (out[j].name != out[i].name) continue;
+            out[i].calls += out[j].calls;
+            out[i].cycles += out[j].cycles;
+            out[j].calls = 0;
+            out[j].cycles = 0;
+        }
+    }
     *segments = out[2].calls;
     return out;
 }
