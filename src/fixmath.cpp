@@ -580,7 +580,7 @@ Num& Num::sqrt() {
     uint32_t top = static_cast<uint32_t>(s) << 16; // >= 2^31: the result is normalised
     uint32_t next = top + sqrt_step(rem, s);
     ex = static_cast<int8_t>((ex >> 1) - 16); // ex is even
-    if (next < top) { // 2^32
+    if (next < top) {                         // 2^32
         next = 0x80000000ul;
         ++ex;
     }

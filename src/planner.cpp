@@ -156,7 +156,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     t.set(~t.shift(32).u32(), -32);
     if (tiny(t)) return 0;
     Num r(1);
-    t.sqrt(); // sin(theta / 2)
+    t.sqrt();               // sin(theta / 2)
     r.add(t).mul(t).div(q); // (1 + sin) sin / q
     // Acceleration along the junction vector d, limited per axis (GRBL's
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
