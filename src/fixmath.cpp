@@ -4,7 +4,222 @@
 
 namespace ll {
 
-uint16_t isqrt32(uint32_t v) {
+namespace {
+
+#if defined(__AVR__)
+// The full product a * b = hi * 2^32 + lo with the hardware 8x8 multiplier, as a routine with
+// its own register convention (one copy in flash, about 100 cycles with the call): a in
+// r22..r25, b in r18..r21; returns lo in r18..r21 and hi in r22..r25; uses r14..r17, r26,
+// r27, r30, r31 and r0 (r1 back to zero). Column k of the byte products (i + j = k) is summed
+// into a 3-byte window (a column's sum plus the carry from below stays under 2^24), whose low
+// byte is then final: result byte k.
+asm(".section .text.__ll_mul32,\"ax\",@progbits\n"
+    ".global __ll_mul32\n"
+    "__ll_mul32:\n"
+    "movw r26, r18\n"
+    "movw r30, r20\n"
+    "clr  r17\n"
+    "mul  r22, r26\n"
+    "movw r14, r0\n"
+    "clr  r16\n"
+    "mov  r18, r14\n"
+    "clr  r14\n"
+    "mul  r22, r27\n"
+    "add  r15, r0\n"
+    "adc  r16, r1\n"
+    "adc  r14, r17\n"
+    "mul  r23, r26\n"
+    "add  r15, r0\n"
+    "adc  r16, r1\n"
+    "adc  r14, r17\n"
+    "mov  r19, r15\n"
+    "clr  r15\n"
+    "mul  r22, r30\n"
+    "add  r16, r0\n"
+    "adc  r14, r1\n"
+    "adc  r15, r17\n"
+    "mul  r23, r27\n"
+    "add  r16, r0\n"
+    "adc  r14, r1\n"
+    "adc  r15, r17\n"
+    "mul  r24, r26\n"
+    "add  r16, r0\n"
+    "adc  r14, r1\n"
+    "adc  r15, r17\n"
+    "mov  r20, r16\n"
+    "clr  r16\n"
+    "mul  r22, r31\n"
+    "add  r14, r0\n"
+    "adc  r15, r1\n"
+    "adc  r16, r17\n"
+    "mul  r23, r30\n"
+    "add  r14, r0\n"
+    "adc  r15, r1\n"
+    "adc  r16, r17\n"
+    "mul  r24, r27\n"
+    "add  r14, r0\n"
+    "adc  r15, r1\n"
+    "adc  r16, r17\n"
+    "mul  r25, r26\n"
+    "add  r14, r0\n"
+    "adc  r15, r1\n"
+    "adc  r16, r17\n"
+    "mov  r21, r14\n"
+    "clr  r14\n"
+    "mul  r23, r31\n"
+    "add  r15, r0\n"
+    "adc  r16, r1\n"
+    "adc  r14, r17\n"
+    "mul  r24, r30\n"
+    "add  r15, r0\n"
+    "adc  r16, r1\n"
+    "adc  r14, r17\n"
+    "mul  r25, r27\n"
+    "add  r15, r0\n"
+    "adc  r16, r1\n"
+    "adc  r14, r17\n"
+    "mov  r22, r15\n"
+    "clr  r15\n"
+    "mul  r24, r31\n"
+    "add  r16, r0\n"
+    "adc  r14, r1\n"
+    "adc  r15, r17\n"
+    "mul  r25, r30\n"
+    "add  r16, r0\n"
+    "adc  r14, r1\n"
+    "adc  r15, r17\n"
+    "mov  r23, r16\n"
+    "clr  r16\n"
+    "mul  r25, r31\n"
+    "add  r14, r0\n"
+    "adc  r15, r1\n"
+    "mov  r24, r14\n"
+    "mov  r25, r15\n"
+    "clr  r1\n"
+    "ret\n"
+    ".text\n");
+
+__attribute__((always_inline)) inline uint32_t mul64(uint32_t a, uint32_t b, uint32_t& lo) {
+    register uint32_t ra asm("r22") = a;
+    register uint32_t rb asm("r18") = b;
+    asm("call __ll_mul32"
+        : "+r"(ra), "+r"(rb)
+        :
+        : "r14", "r15", "r16", "r17", "r26", "r27", "r30", "r31");
+    lo = rb;
+    return ra;
+}
+
+// floor((hi * 2^32 + lo) / 2^shift), saturated: whole bytes by moves, then bit by bit.
+__attribute__((always_inline)) inline uint32_t shr_sat(uint32_t hi, uint32_t lo, uint8_t shift) {
+    asm("1:\n\t"
+        "cpi  %[s], 8\n\t"
+        "brlo 2f\n\t"
+        "mov  %A[lo], %B[lo]\n\t"
+        "mov  %B[lo], %C[lo]\n\t"
+        "mov  %C[lo], %D[lo]\n\t"
+        "mov  %D[lo], %A[hi]\n\t"
+        "mov  %A[hi], %B[hi]\n\t"
+        "mov  %B[hi], %C[hi]\n\t"
+        "mov  %C[hi], %D[hi]\n\t"
+        "clr  %D[hi]\n\t"
+        "subi %[s], 8\n\t"
+        "rjmp 1b\n"
+        "2:\n\t"
+        "tst  %[s]\n\t"
+        "breq 4f\n"
+        "3:\n\t"
+        "lsr  %D[hi]\n\t"
+        "ror  %C[hi]\n\t"
+        "ror  %B[hi]\n\t"
+        "ror  %A[hi]\n\t"
+        "ror  %D[lo]\n\t"
+        "ror  %C[lo]\n\t"
+        "ror  %B[lo]\n\t"
+        "ror  %A[lo]\n\t"
+        "dec  %[s]\n\t"
+        "brne 3b\n"
+        "4:"
+        : [lo] "+r"(lo), [hi] "+r"(hi), [s] "+d"(shift));
+    return hi ? 0xFFFFFFFFul : lo;
+}
+#else
+inline uint32_t mul64(uint32_t a, uint32_t b, uint32_t& lo) {
+    uint64_t p = static_cast<uint64_t>(a) * b;
+    lo = static_cast<uint32_t>(p);
+    return static_cast<uint32_t>(p >> 32);
+}
+
+inline uint32_t shr_sat(uint32_t hi, uint32_t lo, uint8_t shift) {
+    uint64_t p = (static_cast<uint64_t>(hi) << 32 | lo) >> shift;
+    return p >> 32 ? 0xFFFFFFFFul : static_cast<uint32_t>(p);
+}
+#endif
+
+// floor(sqrt(v)), and v - floor(sqrt(v))^2 in rem.
+uint16_t isqrt_rem(uint32_t v, uint32_t& rem) {
+#if defined(__AVR__)
+    // Bit by bit from the top, with hardware squares: the high byte against the top 16 bits of
+    // v (one 8x8 product per bit), then the low byte against all of v (two products per bit,
+    // the high byte's square computed once).
+    uint8_t sh, sl, t, bit, zero;
+    uint16_t hh;
+    uint32_t sq, acc;
+    asm("clr  %[z]\n\t"
+        "clr  %[sh]\n\t"
+        "ldi  %[bit], 0x80\n"
+        "1:\n\t"
+        "mov  %[t], %[sh]\n\t"
+        "or   %[t], %[bit]\n\t"
+        "mul  %[t], %[t]\n\t"
+        "cp   %C[v], r0\n\t"
+        "cpc  %D[v], r1\n\t"
+        "brcs 2f\n\t"
+        "mov  %[sh], %[t]\n"
+        "2:\n\t"
+        "lsr  %[bit]\n\t"
+        "brne 1b\n\t"
+        "mul  %[sh], %[sh]\n\t"
+        "movw %A[hh], r0\n\t"
+        "clr  %A[acc]\n\t" // accepted square: sh^2 * 2^16
+        "clr  %B[acc]\n\t"
+        "movw %C[acc], %A[hh]\n\t"
+        "clr  %[sl]\n\t"
+        "ldi  %[bit], 0x80\n"
+        "3:\n\t"
+        "mov  %[t], %[sl]\n\t"
+        "or   %[t], %[bit]\n\t"
+        "mul  %[t], %[t]\n\t" // (sh * 256 + t)^2 = t^2 + 2 sh t 256 + sh^2 65536
+        "movw %A[sq], r0\n\t"
+        "movw %C[sq], %A[hh]\n\t"
+        "mul  %[t], %[sh]\n\t"
+        "add  %B[sq], r0\n\t"
+        "adc  %C[sq], r1\n\t"
+        "adc  %D[sq], %[z]\n\t"
+        "add  %B[sq], r0\n\t"
+        "adc  %C[sq], r1\n\t"
+        "adc  %D[sq], %[z]\n\t"
+        "cp   %A[v], %A[sq]\n\t"
+        "cpc  %B[v], %B[sq]\n\t"
+        "cpc  %C[v], %C[sq]\n\t"
+        "cpc  %D[v], %D[sq]\n\t"
+        "brcs 4f\n\t"
+        "mov  %[sl], %[t]\n\t"
+        "movw %A[acc], %A[sq]\n\t"
+        "movw %C[acc], %C[sq]\n"
+        "4:\n\t"
+        "lsr  %[bit]\n\t"
+        "brne 3b\n\t"
+        "clr  __zero_reg__\n\t"
+        "sub  %A[v], %A[acc]\n\t"
+        "sbc  %B[v], %B[acc]\n\t"
+        "sbc  %C[v], %C[acc]\n\t"
+        "sbc  %D[v], %D[acc]"
+        : [v] "+r"(v), [sh] "=&r"(sh), [sl] "=&r"(sl), [t] "=&r"(t), [bit] "=&d"(bit),
+          [z] "=&r"(zero), [hh] "=&r"(hh), [sq] "=&r"(sq), [acc] "=&r"(acc));
+    rem = v;
+    return static_cast<uint16_t>(sh << 8 | sl);
+#else
     uint32_t res = 0;
     uint32_t one = 1ul << 30;
     while (one > v) one >>= 2;
@@ -17,11 +232,71 @@ uint16_t isqrt32(uint32_t v) {
         }
         one >>= 2;
     }
+    rem = v;
     return static_cast<uint16_t>(res);
+#endif
+}
+
+// floor(rem * 2^15 / s) for 2^15 <= s < 2^16 and rem <= 2 s: the Newton correction of a
+// square root (a quotient below 2^17).
+uint32_t sqrt_step(uint32_t rem, uint16_t s) {
+    // rem = q0 s + r with q0 <= 2, then 15 quotient bits of r * 2^15 / s.
+    uint8_t q0 = 0;
+    while (rem >= s) {
+        rem -= s;
+        ++q0;
+    }
+    uint16_t r = static_cast<uint16_t>(rem);
+#if defined(__AVR__)
+    uint16_t q;
+    uint8_t n;
+    asm("clr  %A[q]\n\t"
+        "clr  %B[q]\n\t"
+        "ldi  %[n], 15\n"
+        "1:\n\t"
+        "lsl  %A[q]\n\t"
+        "rol  %B[q]\n\t"
+        "lsl  %A[r]\n\t"
+        "rol  %B[r]\n\t"
+        "brcs 2f\n\t"
+        "cp   %A[r], %A[s]\n\t"
+        "cpc  %B[r], %B[s]\n\t"
+        "brcs 3f\n"
+        "2:\n\t"
+        "sub  %A[r], %A[s]\n\t"
+        "sbc  %B[r], %B[s]\n\t"
+        "inc  %A[q]\n"
+        "3:\n\t"
+        "dec  %[n]\n\t"
+        "brne 1b"
+        : [q] "=&r"(q), [r] "+r"(r), [n] "=&d"(n)
+        : [s] "r"(s));
+#else
+    uint16_t q = 0;
+    for (uint8_t i = 0; i < 15; ++i) {
+        bool carry = (r & 0x8000u) != 0;
+        r = static_cast<uint16_t>(r << 1);
+        q = static_cast<uint16_t>(q << 1);
+        if (carry || r >= s) {
+            r = static_cast<uint16_t>(r - s);
+            q = static_cast<uint16_t>(q | 1);
+        }
+    }
+#endif
+    uint32_t out = q;
+    if (q0) out += q0 == 1 ? 0x8000ul : 0x10000ul; // q0 << 15 without a 15-turn shift loop
+    return out;
+}
+
+} // namespace
+
+uint16_t isqrt32(uint32_t v) {
+    uint32_t rem;
+    return isqrt_rem(v, rem);
 }
 
 uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits) {
-    uint32_t q = num / den;
+    uint32_t q = num < den ? 0 : num / den; // short lines: num < den, no library division
     uint32_t rem = num - q * den;
     for (uint8_t i = 0; i < bits; ++i) {
         rem <<= 1;
@@ -34,15 +309,35 @@ uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits) {
     return q;
 }
 
-uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift) {
-    uint64_t p = static_cast<uint64_t>(a) * b;
-    p >>= shift;
-    return p > 0xFFFFFFFFull ? 0xFFFFFFFFul : static_cast<uint32_t>(p);
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
+uint32_t div32_16(uint32_t n, uint16_t d) {
+    return n / d;
+}
+#endif
+
+uint32_t mul_wide(uint32_t a, uint32_t b, uint32_t& lo) {
+    return mul64(a, b, lo);
 }
 
+uint32_t shr64_sat(uint32_t hi, uint32_t lo, uint8_t shift) {
+    return shr_sat(hi, lo, shift);
+}
+
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
+uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift) {
+    uint32_t lo, hi = mul64(a, b, lo);
+    return shr_sat(hi, lo, shift);
+}
+#endif
+
 uint32_t shl_sat(uint32_t x, uint8_t k) {
-    if (k >= 32) return x ? 0xFFFFFFFFul : 0;
-    return x > (0xFFFFFFFFul >> k) ? 0xFFFFFFFFul : x << k;
+    // A bit at a time: the shifts are small where it matters (the speed profile, k < 9), and a
+    // test against 2^32 >> k would be a second variable shift (a loop on the ATmega328P).
+    for (; k != 0 && x != 0; --k) {
+        if (x & 0x80000000ul) return 0xFFFFFFFFul;
+        x <<= 1;
+    }
+    return x;
 }
 
 namespace {
@@ -51,9 +346,15 @@ namespace {
 const uint32_t kAtanQ29[10] LL_PROGMEM = {421657428, 248918915, 131521918, 66762579, 33510843,
                                           16771758,  8387925,   4194219,   2097141,  1048575};
 
-// (a * b) >> 30 for Q30 operands.
+// (a * b) >> 30 for Q30 operands (the arithmetic shift of the exact 64-bit product). From the
+// unsigned product: a negative operand subtracts the other one times 2^32.
 int32_t mul_q30(int32_t a, int32_t b) {
-    return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> 30);
+    uint32_t ua = static_cast<uint32_t>(a), ub = static_cast<uint32_t>(b);
+    uint32_t lo, hi = mul64(ua, ub, lo);
+    if (a < 0) hi -= ub;
+    if (b < 0) hi -= ua;
+    uint8_t top = static_cast<uint8_t>(lo >> 24); // lo >> 30 without a 30-turn shift loop
+    return static_cast<int32_t>(hi << 2 | static_cast<uint8_t>(top >> 6));
 }
 
 // 1 - x * r * t in Q30, with r a Q30 reciprocal constant: one step of a Horner series.
@@ -127,6 +428,7 @@ void small_angle_q30(int32_t h, int32_t& c, int32_t& s, int32_t& k) {
 
 namespace {
 
+#if !defined(__AVR__) // AVR: Num::div in fixmath_avr.cpp
 // floor(hi * 2^32 / d) for hi < d, d >= 2^31: the 32 quotient bits of a normalised division.
 uint32_t div_hi(uint32_t hi, uint32_t d) {
     uint32_t q = 0;
@@ -141,9 +443,11 @@ uint32_t div_hi(uint32_t hi, uint32_t d) {
     }
     return q;
 }
+#endif
 
 } // namespace
 
+#if !defined(__AVR__)
 namespace {
 
 // Exponents live in [-128, 127]: values beyond 2^158 saturate, below 2^-97 become zero.
@@ -162,7 +466,9 @@ Num& finish(Num& n, uint32_t m, int16_t ex) {
 }
 
 } // namespace
+#endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::set(uint32_t v, int8_t exp) {
     if (v == 0) {
         m = 0;
@@ -170,28 +476,45 @@ Num& Num::set(uint32_t v, int8_t exp) {
         return *this;
     }
     int16_t ex = exp;
+    while (!(v >> 24)) { // whole bytes first (byte moves on the ATmega328P)
+        v <<= 8;
+        ex = static_cast<int16_t>(ex - 8);
+    }
     while (!(v & 0x80000000ul)) {
         v <<= 1;
         --ex;
     }
     return finish(*this, v, ex);
 }
+#endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::mul(const Num& o) {
     if (m == 0 || o.m == 0) return set(0);
-    uint64_t p = static_cast<uint64_t>(m) * o.m; // in [2^62, 2^64)
+    uint32_t lo, hi = mul64(m, o.m, lo); // product in [2^62, 2^64)
     int16_t ex = static_cast<int16_t>(e + o.e + 32);
-    if (!(p >> 63)) {
-        p <<= 1;
+    if (!(hi & 0x80000000ul)) {
+        hi = hi << 1 | lo >> 31;
         --ex;
     }
-    return finish(*this, static_cast<uint32_t>(p >> 32), ex);
+    return finish(*this, hi, ex);
+}
+#endif
+
+Num& Num::mulc(uint32_t mant, int8_t exp) {
+    Num c;
+    c.m = mant;
+    c.e = exp;
+    return mul(c);
 }
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::mul(uint32_t v) {
     return mul(Num(v));
 }
+#endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::div(const Num& o) {
     if (m == 0 || o.m == 0) return set(0);
     int16_t ex = static_cast<int16_t>(e - o.e - 32);
@@ -209,11 +532,15 @@ Num& Num::div(const Num& o) {
     return finish(*this, static_cast<uint32_t>(0x80000000ul | (frac >> 1)),
                   static_cast<int16_t>(ex + 1));
 }
+#endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::div(uint32_t v) {
     return div(Num(v));
 }
+#endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::add(const Num& o) {
     if (o.m == 0) return *this;
     if (m == 0) return *this = o;
@@ -223,15 +550,18 @@ Num& Num::add(const Num& o) {
         small = *this;
     }
     uint8_t gap = static_cast<uint8_t>(big.e - small.e);
-    uint32_t sm = gap >= 32 ? 0 : small.m >> gap;
+    uint32_t sm = gap >= 32 ? 0 : shr_sat(0, small.m, gap);
     uint32_t sum = big.m + sm;
     if (sum < big.m) {
         m = static_cast<uint32_t>(0x80000000ul | (sum >> 1));
         e = static_cast<int8_t>(big.e + 1);
         return *this;
     }
-    return set(sum, big.e);
+    m = sum; // >= big.m >= 2^31: normalised
+    e = big.e;
+    return *this;
 }
+#endif
 
 Num& Num::sqrt() {
     if (m == 0) return *this;
@@ -242,32 +572,79 @@ Num& Num::sqrt() {
         v >>= 1;
         ++ex;
     }
-    // sqrt(v * 2^ex) = sqrt(v) * 2^(ex/2); r = sqrt(v) * 2^16 to 16 bits from isqrt32, then one
-    // Newton step r' = (r + v * 2^32 / r) / 2 (2^-31 relative). r is a floor, so v * 2^32 / r
-    // can reach 2^32 just below v = 2^32.
-    uint32_t r = static_cast<uint32_t>(isqrt32(v)) << 16;
-    uint64_t q = v >= r ? (1ull << 32) + div_hi(v - r, r) : div_hi(v, r);
-    uint64_t next = (static_cast<uint64_t>(r) + q) >> 1;
-    if (next >> 32) return set(1, static_cast<int8_t>(ex / 2 + 16));
-    return set(static_cast<uint32_t>(next), static_cast<int8_t>(ex / 2 - 16));
+    // sqrt(v * 2^ex) = sqrt(v) * 2^(ex/2). s = floor(sqrt(v)) to 16 bits, then one Newton step
+    // from r = s * 2^16: r' = (r + v * 2^32 / r) / 2 = s * 2^16 + (v - s^2) * 2^15 / s, within
+    // one unit of sqrt(v) * 2^16 (2^-31 relative). It reaches 2^32 just below v = 2^32.
+    uint32_t rem;
+    uint16_t s = isqrt_rem(v, rem);
+    uint32_t top = static_cast<uint32_t>(s) << 16; // >= 2^31: the result is normalised
+    uint32_t next = top + sqrt_step(rem, s);
+    ex = static_cast<int8_t>((ex >> 1) - 16); // ex is even
+    if (next < top) {                         // 2^32
+        next = 0x80000000ul;
+        ++ex;
+    }
+    m = next;
+    e = ex;
+    return *this;
 }
 
+Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask) {
+    // Exact 64-bit sums while every value is below 2^30 (6 squares below 2^63); larger values
+    // (travel beyond 4 km) lose their two low bits first.
+    uint8_t drop = 0;
+    for (uint8_t i = 0; i < n; ++i) {
+        if (static_cast<uint8_t>(v[i] >> 24) >= 0x40) drop = 2;
+    }
+    uint32_t hi = 0, lo = 0;
+    for (uint8_t i = 0; i < n; ++i, mask >>= 1) {
+        uint32_t x = v[i];
+        if (x == 0 || !(mask & 1)) continue;
+        if (drop) x >>= 2;
+        uint32_t l, h = mul64(x, x, l);
+        lo += l;
+        if (lo < l) ++h; // h <= 2^32 - 2
+        hi += h;
+    }
+    return num64(hi, lo, static_cast<int8_t>(2 * drop));
+}
+
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
+Num num64(uint32_t hi, uint32_t lo, int8_t exp) {
+    // Normalise the top word, then shift in the bits of the low word it makes room for.
+    Num r;
+    if (hi == 0) return r.set(lo, exp);
+    r.set(hi, static_cast<int8_t>(32 + exp));
+    uint8_t k = static_cast<uint8_t>(32 + exp - r.e);
+    if (k) r.m |= shr_sat(0, lo, static_cast<uint8_t>(32 - k));
+    return r;
+}
+#endif
+
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 uint32_t Num::u32() const {
     if (m == 0 || e <= -32) return 0;
     if (e > 0) return 0xFFFFFFFFul;
-    return m >> static_cast<uint8_t>(-e);
+    return shr64_sat(0, m, static_cast<uint8_t>(-e));
 }
+#endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 uint32_t Num::of(uint32_t x) const {
-    Num t(x);
-    return t.mul(*this).u32();
+    // floor(x * m * 2^e), from the exact 64-bit product.
+    if (m == 0 || x == 0 || e <= -64) return 0;
+    if (e > 0) return 0xFFFFFFFFul;
+    return mul_shr(x, m, static_cast<uint8_t>(-e));
 }
+#endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 int8_t Num::cmp(const Num& o) const {
     if (m == 0 || o.m == 0) return m == o.m ? 0 : (m == 0 ? -1 : 1);
     if (e != o.e) return e < o.e ? -1 : 1;
     if (m != o.m) return m < o.m ? -1 : 1;
     return 0;
 }
+#endif
 
 } // namespace ll

@@ -9,11 +9,12 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     g.dirs = 0;
     // §7.1: drop still axes, insertion-sort the rest by distance, decreasing. Ties keep the
     // machine-axis order so that the result is deterministic.
-    for (uint8_t a = 0; a < kAxes; ++a) {
+    uint8_t bit = 1;
+    for (uint8_t a = 0; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         int32_t d = delta[a];
         if (d == 0) continue;
         uint32_t dist = d < 0 ? static_cast<uint32_t>(-(d + 1)) + 1u : static_cast<uint32_t>(d);
-        if (d < 0) g.dirs = static_cast<uint8_t>(g.dirs | (1u << a));
+        if (d < 0) g.dirs = static_cast<uint8_t>(g.dirs | bit);
         uint8_t i = g.m;
         while (i > 0 && g.dist[i - 1] < dist) {
             g.dist[i] = g.dist[i - 1];
@@ -29,23 +30,23 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     // §7.2: P = 2^k, the smallest power of two with P >= 8 d_1.
     uint32_t d1 = g.dist[0];
     uint8_t k = 3;
-    while ((1ul << k) < 8ul * d1) ++k;
+    for (uint32_t p = 8; p < 8ul * d1; p <<= 1) ++k; // not 1 << k: a shift loop per turn
     g.shift = k;
-    g.slope[0] = 1ul << k;
+    g.slope[0] = 1ul << kLineUnit;
     for (uint8_t j = 1; j < g.m; ++j) {
-        // round(d_j * 2^k / d_1) = floor((2 d_j * 2^k / d_1 + 1) / 2)
+        // round(d_j * 2^k / d_1) = floor((2 d_j * 2^k / d_1 + 1) / 2), then in units of
+        // 2^(kLineUnit - k) (the same value, aligned: line_advance shifts by a constant).
         uint32_t twice = div_frac(g.dist[j], d1, static_cast<uint8_t>(k + 1));
-        g.slope[j] = (twice + 1) >> 1;
+        g.slope[j] = ((twice + 1) >> 1) << (kLineUnit - k);
     }
     return true;
 }
 
 void line_start(const LineGeometry& g, LineCursor& c) {
     c.x1 = 0;
-    uint32_t half = 1ul << (g.shift - 1);
     for (uint8_t j = 0; j < g.m; ++j) {
         c.pos[j] = 0;
-        c.frac[j] = half;
+        c.frac[j] = 1ul << (kLineUnit - 1); // P/2
     }
 }
 
@@ -53,7 +54,6 @@ void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[k
     c.x1 += len;
     c.pos[0] += len;
     e[0] = len;
-    const uint32_t mask = (1ul << g.shift) - 1;
     if (c.x1 == g.dist[0]) {
         // Last segment: S_j * d_1 + P/2 lands within 1/16 tick of d_j + 1/2 by construction
         // (|d_1 (S_j / P - s_j)| <= d_1 / (2P) <= 1/16), so the formula gives d_j exactly;
@@ -65,9 +65,12 @@ void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[k
         return;
     }
     for (uint8_t j = 1; j < g.m; ++j) {
-        uint32_t acc = c.frac[j] + g.slope[j] * len; // < 2^27 + 2^27 * 16 < 2^32
-        uint8_t inc = static_cast<uint8_t>(acc >> g.shift);
-        c.frac[j] = acc & mask;
+        // < 2^27 + 2^27 * 16 < 2^32; one tick per segment is the common case (no product)
+        uint32_t acc = c.frac[j] + (len == 1 ? g.slope[j] : g.slope[j] * len);
+        // acc >> 27 from the top byte: avr-gcc 5.4 makes a 27-turn loop of a 32-bit shift
+        uint8_t top = static_cast<uint8_t>(acc >> 24);
+        uint8_t inc = static_cast<uint8_t>(top >> (kLineUnit - 24));
+        c.frac[j] = acc & ((1ul << kLineUnit) - 1);
         c.pos[j] += inc;
         e[j] = inc;
     }

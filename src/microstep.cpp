@@ -7,9 +7,11 @@ uint8_t micro_split(const uint8_t e[], uint8_t m, MicroRun out[]) {
     uint8_t order[kAxes];
     uint8_t n = 0;
     uint8_t set = 1;
+    uint8_t bit = 1;
     for (uint8_t j = 1; j < m; ++j) {
+        bit = static_cast<uint8_t>(bit << 1); // 1 << j
         if (e[j] == 0) continue;
-        set = static_cast<uint8_t>(set | (1u << j));
+        set = static_cast<uint8_t>(set | bit);
         uint8_t i = n;
         while (i > 0 && e[order[i - 1]] > e[j]) {
             order[i] = order[i - 1];

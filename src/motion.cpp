@@ -224,8 +224,8 @@ void position(int32_t steps[kAxes]) {
     // Undo what is queued but not executed: the rest of the current run, then every run
     // between the consumer and the producer.
     auto undo = [&](uint8_t s, uint8_t d, uint8_t n) {
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            if (s & (1u << a)) steps[a] += (d & (1u << a)) ? n : -static_cast<int32_t>(n);
+        for (uint8_t a = 0; a < kAxes; ++a, s >>= 1, d >>= 1) {
+            if (s & 1) steps[a] += (d & 1) ? n : -static_cast<int32_t>(n);
         }
     };
     undo(cur_steps, cur_dirs, remaining);

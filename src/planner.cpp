@@ -14,32 +14,54 @@ uint32_t axis_limit(const Settings& s, uint8_t a, Limit which) {
     return which == kRate ? s.axis[a].max_rate : s.axis[a].accel;
 }
 
-// min over axes with comp[a] > 0 of lim[a] / comp[a], times `scale`: the largest value along a
-// direction that keeps every axis within its own limit (GRBL's limit_value_by_axis_maximum).
-uint32_t limit_along(const Settings& s, Limit which, const uint32_t comp[kAxes], Num scale) {
-    Num best{};
-    bool any = false;
+// Normalised constants for Num::mulc().
+constexpr uint32_t k3_6 = 0xE6666666ul; // 3.6 = k3_6 * 2^-30: units/s^2 x1000 -> units/min^2
+constexpr int8_t k3_6e = -30;
+constexpr uint32_t kMilli = 0x83126E97ul; // 1/1000 = kMilli * 2^-41 (1/128000: 2^-48)
+constexpr uint32_t kMicro = 0x8637BD05ul; // 1e-6 = kMicro * 2^-51 (5e-7: 2^-52)
+
+// n1 / d1 < n2 / d2, exactly (64-bit products).
+bool ratio_less(uint32_t n1, uint32_t d1, uint32_t n2, uint32_t d2) {
+    if (n1 == n2) return d1 > d2;
+    uint32_t l1, h1 = mul_wide(n1, d2, l1);
+    uint32_t l2, h2 = mul_wide(n2, d1, l2);
+    return h1 != h2 ? h1 < h2 : l1 < l2;
+}
+
+// The axis with comp[a] > 0 whose lim[a] / comp[a] is the smallest (the first one on a tie),
+// kAxes when every comp[a] is 0.
+uint8_t tightest(const Settings& s, Limit which, const uint32_t comp[kAxes]) {
+    uint8_t best = kAxes;
     for (uint8_t a = 0; a < kAxes; ++a) {
         if (comp[a] == 0) continue;
-        Num v(axis_limit(s, a, which));
-        v.div(comp[a]);
-        if (!any || v.cmp(best) < 0) best = v;
-        any = true;
+        if (best == kAxes ||
+            ratio_less(axis_limit(s, a, which), comp[a], axis_limit(s, best, which), comp[best])) {
+            best = a;
+        }
     }
-    if (!any) return 0xFFFFFFFFul;
-    if (which == kAccel) scale.mul(Num(18)).div(5); // units/s^2 x1000 -> units/min^2
-    uint32_t v = best.mul(scale).u32();
-    return v ? v : 1;
+    return best;
+}
+
+// x <= 5e-7 (GRBL's junction thresholds): 5e-7 = kMicro 2^-52.
+bool tiny(const Num& x) {
+    return x.m == 0 || x.e < -52 || (x.e == -52 && x.m <= kMicro);
 }
 
 // Euclidean norm of kAxes 32-bit components.
 Num norm(const uint32_t v[kAxes]) {
-    Num sum{};
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        Num x(v[a]);
-        sum.add(x.mul(x));
-    }
-    return sum.sqrt();
+    return sum_squares(v, kAxes).sqrt();
+}
+
+} // namespace
+
+namespace {
+
+// Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated length:
+// Euclidean over the move's group (seed §3.1), at least 1.
+uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uint32_t x[kAxes]) {
+    for (uint8_t a = 0; a < kAxes; ++a) x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
+    uint32_t len = sum_squares(x, kAxes, group).sqrt().u32();
+    return len ? len : 1;
 }
 
 // Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
@@ -56,18 +78,23 @@ uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
 } // namespace
 
 void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out) {
-    // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated
-    // length: Euclidean over the move's group (seed §3.1).
-    uint32_t x[kAxes], xg[kAxes];
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
-        xg[a] = (group & (1u << a)) ? x[a] : 0;
+    uint32_t x[kAxes];
+    out.len_q8 = travel(m, delta, group, x);
+    // limit_along() for both limits, sharing len / x[a] when one axis bounds both (the common
+    // case): one division.
+    const Settings& s = *m.settings;
+    uint8_t ar = tightest(s, kRate, x), aa = tightest(s, kAccel, x);
+    if (ar == kAxes) {
+        out.vmax = out.accel = 0xFFFFFFFFul; // nothing moves
+        return;
     }
-    out.len_q8 = norm(xg).u32();
-    if (out.len_q8 == 0) out.len_q8 = 1;
-    Num len(out.len_q8);
-    out.vmax = limit_along(*m.settings, kRate, x, len);
-    out.accel = limit_along(*m.settings, kAccel, x, len);
+    Num r(out.len_q8);
+    r.div(x[ar]);
+    uint32_t v = r.of(s.axis[ar].max_rate);
+    out.vmax = v ? v : 1;
+    if (aa != ar) r.set(out.len_q8).div(x[aa]);
+    v = r.mulc(k3_6, k3_6e).of(s.axis[aa].accel); // units/s^2 x1000 -> units/min^2
+    out.accel = v ? v : 1;
 }
 
 int32_t Planner::delta(const PlanBlock& b, uint8_t axis) {
@@ -89,9 +116,18 @@ void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
     }
 }
 
+namespace {
+
+// Squared speed of a feed (units/min x1000), (units/min)^2.
+uint32_t speed2_of(uint32_t feed) {
+    Num v(feed);
+    return v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
+}
+
+} // namespace
+
 uint32_t Planner::nominal2(const PlanBlock& b) {
-    Num v(b.feed);
-    return v.mul(v).div(1000000).u32();
+    return speed2_of(b.feed);
 }
 
 // Junction speed squared with the previous move (GRBL's junction deviation, $11), from the
@@ -101,67 +137,106 @@ uint32_t Planner::nominal2(const PlanBlock& b) {
 //   v_junction^2 = a * delta * sin (1 + sin) / q.
 // Writing 1 - sin as q / (1 + sin) keeps full precision on nearly straight paths, where a
 // chain of short segments spends its time; |w| keeps it near reversals.
-uint32_t Planner::junction2(const int32_t unit[kAxes]) const {
-    uint32_t dc[kAxes], wc[kAxes];
+uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
+    uint32_t dc[kAxes];
+    uint32_t a_min = 0xFFFFFFFFul;
+    const Settings& s = *m_->settings;
     for (uint8_t a = 0; a < kAxes; ++a) {
         dc[a] = abs32(unit[a] - prev_unit_[a]); // <= 2^30
-        wc[a] = abs32(unit[a] + prev_unit_[a]);
+        if (dc[a] != 0 && s.axis[a].accel < a_min) a_min = s.axis[a].accel;
     }
-    Num dn = norm(dc);
-    Num q = dn;
-    q.mul(dn).shift(-60);
-    Num sin_half = norm(wc).shift(-30);
+    Num q = sum_squares(dc, kAxes); // |d|^2 / 4
+    q.shift(-60);
     // GRBL's thresholds: |cos theta| > 0.999999 is straight on (no limit) or a reversal
     // (stop), i.e. q or p below 5e-7.
-    Num eps(1);
-    eps.div(2000000);
-    if (q.cmp(eps) <= 0) return 0xFFFFFFFFul;
-    Num p = sin_half;
-    if (p.mul(sin_half).cmp(eps) <= 0) return 0;
-    // Acceleration along the junction vector d, limited per axis; delta in µm / 1000.
-    uint32_t ja = limit_along(*m_->settings, kAccel, dc, dn);
+    if (tiny(q)) return 0xFFFFFFFFul;
+    // Only min(junction, limit) matters. With p = 1 - q = sin^2 <= 1, sin (1 + sin) >= p >= 1/2
+    // when q < 1/2 (q.e < -32), and the junction acceleration (limited per axis along d) is at
+    // least the smallest axis acceleration of d, so
+    //   v_junction^2 >= a_min x 3.6 x delta / (2000 q) >= limit  when  a_min delta >= 1024 q limit
+    // (a margin of 1.8 over every truncation below): then the junction does not limit.
+    // Nearly straight chains of short segments (the common case) stop here.
+    if (q.e < -32) {
+        Num lhs(a_min);
+        Num rhs(limit);
+        if (lhs.mul(m_->junction_dev_um).cmp(rhs.mul(q).shift(10)) >= 0) return 0xFFFFFFFFul;
+    }
+    // The exact formula (rare in chains of short segments).
+    // p = 1 - q to 2^-32: near a reversal (p small) its relative error grows to 2^-11 at the
+    // 5e-7 threshold, where v_junction^2 is a few (mm/min)^2, well within a unit.
+    Num t = q;
+    t.set(~t.shift(32).u32(), -32);
+    if (tiny(t)) return 0;
     Num r(1);
-    r.add(sin_half).mul(sin_half).div(q).mul(ja).mul(m_->junction_dev_um).div(1000);
-    return r.u32();
+    t.sqrt();               // sin(theta / 2)
+    r.add(t).mul(t).div(q); // (1 + sin) sin / q
+    // Acceleration along the junction vector d, limited per axis (GRBL's
+    // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
+    // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
+    // 1000.
+    uint8_t a = tightest(s, kAccel, dc);
+    t = q;
+    t.sqrt().shift(30).mulc(k3_6, k3_6e);
+    uint32_t ja = Num(s.axis[a].accel).div(dc[a]).mul(t).u32();
+    r.mul(ja ? ja : 1).mul(m_->junction_dev_um);
+    return r.mulc(kMilli, -41).u32(); // / 1000
 }
 
 bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                   bool rapid) {
+    // Few locals, in scopes that do not overlap (they share their stack slots): the deepest
+    // stack of the firmware runs through here.
     PlanBlock& b = ring_[index(count_)];
-    bool moves = false;
-    int32_t d[kAxes], du[kAxes];
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        d[a] = target[a] - last_[a];
-        du[a] = target_um[a] - last_um_[a];
-        if (d[a] != 0) moves = true;
+    uint8_t group;
+    {
+        int32_t d[kAxes];
+        bool moves = false;
+        for (uint8_t a = 0; a < kAxes; ++a) {
+            d[a] = target[a] - last_[a];
+            if (d[a] != 0) moves = true;
+        }
+        if (!moves) {
+            for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
+            return false;
+        }
+        for (uint8_t a = 0; a < kAxes; ++a) {
+            last_[a] = target[a];
+            uint32_t v = static_cast<uint32_t>(d[a]);
+            b.delta[a][0] = static_cast<uint8_t>(v);
+            b.delta[a][1] = static_cast<uint8_t>(v >> 8);
+            b.delta[a][2] = static_cast<uint8_t>(v >> 16);
+        }
+        group = regulated_group(*m_, d);
+        b.group = group;
+        MoveLimits lim;
+        move_limits(*m_, d, group, lim);
+        b.len_q8 = lim.len_q8;
+        b.feed = rapid || feed > lim.vmax ? lim.vmax : feed;
+        if (b.feed == 0) b.feed = 1;
+        // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000.
+        uint32_t lo, hi = mul_wide(lim.len_q8, lim.accel, lo);
+        b.dv2 = num64(hi, lo).mulc(kMilli, -48).u32();
     }
-    for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
-    if (!moves) return false;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        last_[a] = target[a];
-        uint32_t v = static_cast<uint32_t>(d[a]);
-        b.delta[a][0] = static_cast<uint8_t>(v);
-        b.delta[a][1] = static_cast<uint8_t>(v >> 8);
-        b.delta[a][2] = static_cast<uint8_t>(v >> 16);
-    }
-    b.group = regulated_group(*m_, d);
-    MoveLimits lim;
-    move_limits(*m_, d, b.group, lim);
-    b.feed = rapid || feed > lim.vmax ? lim.vmax : feed;
-    if (b.feed == 0) b.feed = 1;
-    // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000.
-    b.dv2 = Num(lim.len_q8).mul(lim.accel).div(128000).u32();
 
-    // Unit vector of the commanded move (Q29), for the junction.
-    int32_t unit[kAxes];
+    // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
+    // first, then the unit vector in its place.
     uint32_t xu[kAxes];
-    for (uint8_t a = 0; a < kAxes; ++a) xu[a] = (b.group & (1u << a)) ? abs32(du[a]) : 0;
+    uint8_t neg = 0; // axes whose commanded travel is negative
+    uint8_t in_group = group;
+    for (uint8_t a = 0, bit = 1; a < kAxes;
+         ++a, bit = static_cast<uint8_t>(bit << 1), in_group >>= 1) {
+        int32_t du = target_um[a] - last_um_[a];
+        last_um_[a] = target_um[a];
+        if (du < 0) neg = static_cast<uint8_t>(neg | bit);
+        xu[a] = (in_group & 1) ? abs32(du) : 0;
+    }
     Num to_unit(1, 29);
     to_unit.div(norm(xu));
-    for (uint8_t a = 0; a < kAxes; ++a) {
+    int32_t* unit = reinterpret_cast<int32_t*>(xu);
+    for (uint8_t a = 0; a < kAxes; ++a, neg >>= 1) {
         uint32_t u = to_unit.of(xu[a]);
         if (u > (1ul << 29)) u = 1ul << 29;
-        unit[a] = du[a] < 0 ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+        unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
     b.curve = 0;
     finish_block(b, unit, unit);
@@ -170,11 +245,12 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
 
 void Planner::finish_block(PlanBlock& b, const int32_t unit_in[kAxes],
                            const int32_t unit_out[kAxes]) {
-    uint32_t v_junction2 = prev_group_ == b.group && count_ > 0 ? junction2(unit_in) : 0;
+    // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
+    uint32_t limit = count_ > 0 ? speed2_of(min32(b.feed, ring_[index(count_ - 1)].feed)) : 0;
+    uint32_t v_junction2 = prev_group_ == b.group && count_ > 0 ? junction2(unit_in, limit) : 0;
     for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit_out[a];
-    uint32_t prev_nominal2 = count_ > 0 ? nominal2(ring_[index(count_ - 1)]) : 0;
     prev_group_ = b.group;
-    b.v_max_entry2 = min32(v_junction2, min32(nominal2(b), prev_nominal2));
+    b.v_max_entry2 = min32(v_junction2, limit);
     b.v_entry2 = 0;
     ++count_;
     recalculate();
@@ -195,9 +271,9 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     while (curve_used_ & (1u << slot)) ++slot;
     curve_used_ = static_cast<uint8_t>(curve_used_ | (1u << slot));
     curves_[slot] = curve;
-    curves_[slot].len_q8 = shape.len_q8;
     PlanBlock& b = ring_[index(count_)];
     b.curve = static_cast<uint8_t>(slot + 1);
+    b.len_q8 = shape.len_q8;
     for (uint8_t a = 0; a < kAxes; ++a) {
         last_[a] = target[a];
         last_um_[a] = target_um[a];
@@ -234,21 +310,41 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     return true;
 }
 
-void Planner::recalculate() {
+void Planner::recalculate(bool all) {
+    // Pointer walks (an index modulo the ring and a 33-byte stride per block cost more than the
+    // passes themselves on the ATmega328P).
+    PlanBlock* const first = ring_;
+    PlanBlock* const last = ring_ + (kPlannerSize - 1);
     // Backward pass: each move must be able to slow down to the next one's entry (0 after the
     // last move). The move being executed keeps its entry speed.
+    // A new move only raises what the moves before it may reach. Once a move's entry comes out
+    // at its maximum and was already there (the forward pass only lowers), every earlier move
+    // keeps its entry: the passes stop there (in a chain of short moves, a few moves from the
+    // end instead of the whole ring). Only while the oldest move is being executed: its entry
+    // is then fixed, as it was at the last pass; otherwise it is recomputed from scratch.
+    PlanBlock* b = &ring_[index(static_cast<uint8_t>(count_ - 1))];
     uint32_t next_entry = 0;
-    for (uint8_t i = count_; i-- > first_begun_;) {
-        PlanBlock& b = ring_[index(i)];
-        b.v_entry2 = min32(b.v_max_entry2, add_sat(next_entry, b.dv2));
-        next_entry = b.v_entry2;
+    uint8_t pos = count_;
+    uint8_t from = 0; // where the forward pass starts
+    while (pos-- > first_begun_) {
+        uint32_t v = add_sat(next_entry, b->dv2);
+        if (v >= b->v_max_entry2) {
+            v = b->v_max_entry2;
+            if (!all && first_begun_ && b->v_entry2 == v) {
+                from = pos;
+                break;
+            }
+        }
+        b->v_entry2 = v;
+        next_entry = v;
+        b = b == first ? last : b - 1;
     }
     // Forward pass: no move can enter faster than the previous one can accelerate to.
-    for (uint8_t i = 0; i + 1 < count_; ++i) {
-        const PlanBlock& b = ring_[index(i)];
-        PlanBlock& n = ring_[index(static_cast<uint8_t>(i + 1))];
-        uint32_t reach = add_sat(b.v_entry2, b.dv2);
-        if (n.v_entry2 > reach) n.v_entry2 = reach;
+    b = &ring_[index(from)];
+    for (uint8_t n = static_cast<uint8_t>(count_ - from); n > 1; --n) {
+        uint32_t reach = add_sat(b->v_entry2, b->dv2);
+        b = b == last ? first : b + 1;
+        if (b->v_entry2 > reach) b->v_entry2 = reach;
     }
 }
 
@@ -256,19 +352,22 @@ MoveSpec Planner::spec_of_first() const {
     const PlanBlock& b = ring_[head_];
     MoveSpec s;
     for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(b, a);
-    if (b.curve) {
-        const CurveParams& c = curves_[b.curve - 1];
-        s.len_q8 = c.len_q8;
-        uint8_t ax[3];
-        plane_axes(c.plane, ax);
-        s.accel = curve_accel(*m_, c.plane, s.delta[ax[2]] != 0);
-        s.curve = &c;
-    } else {
-        MoveLimits lim;
-        move_limits(*m_, s.delta, b.group, lim);
-        s.len_q8 = lim.len_q8;
-        s.accel = lim.accel;
-        s.curve = nullptr;
+    s.len_q8 = b.len_q8;
+    s.accel = 0;
+    s.dv2 = b.dv2; // the profile from the planner's own 2 a L
+    s.curve = b.curve ? &curves_[b.curve - 1] : nullptr;
+    if (b.dv2 == 0xFFFFFFFFul) {
+        // dv2 saturated: the acceleration from the limits again.
+        s.dv2 = 0;
+        if (s.curve) {
+            uint8_t ax[3];
+            plane_axes(s.curve->plane, ax);
+            s.accel = curve_accel(*m_, s.curve->plane, s.delta[ax[2]] != 0);
+        } else {
+            MoveLimits lim;
+            move_limits(*m_, s.delta, b.group, lim);
+            s.accel = lim.accel;
+        }
     }
     s.feed = b.feed;
     s.v_entry2 = b.v_entry2;
@@ -297,7 +396,7 @@ void Planner::restart_first(uint32_t remaining, uint32_t total) {
     if (total != 0) b.dv2 = Num(remaining).div(total).of(b.dv2);
     b.v_entry2 = 0;
     first_begun_ = 1;
-    recalculate();
+    recalculate(true);
 }
 
 } // namespace ll

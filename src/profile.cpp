@@ -33,31 +33,21 @@ uint32_t profile_a(const Profile& p, uint32_t x2) {
 void SqrtTracker::reset(uint32_t a) {
     r = isqrt32(a);
     c = r * r;
-    c_next = c + 2 * r + 1;
 }
 
 bool SqrtTracker::seek(uint32_t a) {
     uint32_t before = r;
-    if (a >= c_next) {
-        // Moving up: at most a few steps per macro segment; a long way means a jump (new move
-        // or feed hold), where one full square root is cheaper than walking.
-        if (a - c_next > 64 * (r + 1)) {
-            reset(a);
-        } else {
-            while (a >= c_next) {
-                c = c_next;
-                c_next += 2 * ++r + 1;
-            }
+    // A few steps of R per macro segment; a long way (a new move, a feed hold) is a jump, where
+    // one full square root is cheaper than walking: beyond 64 (R + 1) of A.
+    uint32_t far = ((r + 1) << 8) >> 2; // byte move and two shifts, not a 6-turn loop
+    if ((a > c ? a - c : c - a) > far) {
+        reset(a);
+    } else {
+        for (uint32_t step = 2 * r + 1; a >= c + step; step += 2) { // (R + 1)^2 = R^2 + 2 R + 1
+            c += step;
+            ++r;
         }
-    } else if (a < c) {
-        if (c - a > 64 * r) {
-            reset(a);
-        } else {
-            while (a < c) {
-                c_next = c;
-                c -= 2 * --r + 1;
-            }
-        }
+        while (a < c) c -= 2 * --r + 1;
     }
     return r != before;
 }

@@ -8,6 +8,7 @@ namespace {
 // µm x 256 and feeds in mm/min x 1000: 960000000 * len_q8 / (feed * d_1).
 constexpr uint32_t kCruiseNum = 960000000ul;
 static_assert(60ull * kCpuHz * 256 / 1000 * 1000 / 256 == kCruiseNum, "units");
+static_assert(kCruiseNum >> 30 == 0 && (kCruiseNum << 2) >> 31 == 1, "kCruiseNum << 2 normalised");
 // floor(60 * kCpuHz * 256 / 1000 * sqrt(500) / 2): D = 2 * kSqrtCHalf * sqrt(s len_um / (a d_1)),
 // the numerator of Delta_1 = D / sqrt(A) (docs/motion.md, "Wait numerator").
 constexpr uint32_t kSqrtCHalf = 2747680330ul;
@@ -27,6 +28,7 @@ uint32_t max3(uint32_t a, uint32_t b, uint32_t c) {
 
 void StepGen::configure(const StepLengths* lengths, uint16_t min_period,
                         const Num* um_q8_per_step) {
+    lens_valid_ = false; // the step lengths may have changed
     lengths_ = lengths;
     min_period_ = min_period;
     um_q8_per_step_ = um_q8_per_step;
@@ -40,18 +42,18 @@ bool StepGen::begin(const MoveSpec& spec) {
         ln_.g.m = 0;
         return false;
     }
-    len_q8_ = spec.len_q8;
-    accel_ = spec.accel;
-    feed_ = spec.feed;
-    v_nominal2_ = spec.v_nominal2;
-    v_exit2_ = spec.v_exit2;
     line_start(ln_.g, ln_.c);
     build_k_table(spec.group);
     ln_.k_err = 0;
+    return start_profile(spec, ln_.g.dist[0]);
+}
+
+bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
+    take_spec(spec);
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
-    prepare_profile(entry, spec.v_exit2, ln_.g.dist[0]);
+    prepare_profile(entry, spec.v_exit2, ticks);
     if (holding_) {
         a_hold_ = prof_.a_entry;
         x2_hold_ = 0;
@@ -67,8 +69,9 @@ void StepGen::build_k_table(uint8_t group) {
     const uint8_t sets = static_cast<uint8_t>(1u << (m - 1));
     for (uint8_t sub = 0; sub < sets; ++sub) {
         uint8_t mask = static_cast<uint8_t>(1u << ln_.g.axis[0]);
-        for (uint8_t j = 1; j < m; ++j) {
-            if (sub & (1u << (j - 1))) mask = static_cast<uint8_t>(mask | (1u << ln_.g.axis[j]));
+        uint8_t bits = sub; // sorted position j in bit j - 1
+        for (uint8_t j = 1; j < m; ++j, bits >>= 1) {
+            if (bits & 1) mask = static_cast<uint8_t>(mask | (1u << ln_.g.axis[j]));
         }
         ln_.mask[sub] = mask;
     }
@@ -79,17 +82,25 @@ void StepGen::build_k_table(uint8_t group) {
     // regulated axis steps (seed §3.1: the other groups follow) take the mean regulated step
     // time, so the followers move at their average rate rather than in bursts. Altogether
     //   K[P] = L_P * count_g / sum_g  (Q20), and 1 for a run without a regulated axis.
-    uint32_t lens[1u << (kAxes - 1)];
+    // The step lengths (one square root each) depend on the axis sets only: kept from the
+    // previous line (consecutive lines mostly move the same axes in the same order).
+    uint32_t* lens = ln_.lens;
     for (uint8_t sub = 0; sub < sets; ++sub) {
-        lens[sub] = step_length(*lengths_, static_cast<uint8_t>(ln_.mask[sub] & group));
+        uint8_t set = static_cast<uint8_t>(ln_.mask[sub] & group);
+        if (!lens_valid_ || ln_.lens_set[sub] != set) {
+            ln_.lens_set[sub] = set;
+            lens[sub] = step_length(*lengths_, set);
+        }
     }
-    Num sum_g{};
-    uint32_t count_g = 0;
-    for (uint8_t i = 0; i < m; ++i) {
+    lens_valid_ = true;
+    uint32_t sum_hi = 0, sum_lo = 0, count_g = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
+    for (uint8_t i = 0, set = 0; i < m; ++i, set = static_cast<uint8_t>(2 * set + 1)) {
         uint32_t n = ln_.g.dist[i] - (i + 1 < m ? ln_.g.dist[i + 1] : 0);
-        uint32_t len = lens[(1u << i) - 1];
-        if (len != 0) {
-            sum_g.add(Num(n).mul(len));
+        uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
+        if (len != 0 && n != 0) {
+            uint32_t lo, hi = mul_wide(n, len, lo);
+            sum_lo += lo;
+            sum_hi += hi + (sum_lo < lo);
             count_g += n;
         }
     }
@@ -99,7 +110,7 @@ void StepGen::build_k_table(uint8_t group) {
         return;
     }
     Num r(count_g, 20);
-    r.div(sum_g);
+    r.div(num64(sum_hi, sum_lo));
     ln_.kmax = 0;
     for (uint8_t sub = 0; sub < sets; ++sub) {
         ln_.k[sub] = lens[sub] != 0 ? r.of(lens[sub]) : 1ul << 20;
@@ -116,6 +127,7 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     const CurveParams& c = *spec.curve;
     if (!um_q8_per_step_) return false;
     ln_.g.m = 0;
+    lens_valid_ = false; // the curve's state overwrites the lines
     plane_axes(c.plane, cv_.axes);
     // The path is timed along the regulated axes only (seed §3.1): the plane's, and the normal
     // axis' when it belongs to the group (the planner measured the length the same way).
@@ -151,67 +163,89 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
                                   : cv_.w.bezier(e, centre, other);
     if (!ok) return false;
     curve_ = &c;
+    // The profile's reference axis is a virtual one with 1000 ticks per mm (µm) along the path.
+    cv_.ref_um = spec.len_q8 >> 8;
+    if (cv_.ref_um == 0) cv_.ref_um = 1;
+    cv_.x_q8 = 0;
+    return start_profile(spec, cv_.ref_um);
+}
+
+void StepGen::take_spec(const MoveSpec& spec) {
     len_q8_ = spec.len_q8;
-    accel_ = spec.accel;
     feed_ = spec.feed;
     v_nominal2_ = spec.v_nominal2;
     v_exit2_ = spec.v_exit2;
-    // The profile's reference axis is a virtual one with 1000 ticks per mm (µm) along the path.
-    cv_.ref_um = len_q8_ >> 8;
-    if (cv_.ref_um == 0) cv_.ref_um = 1;
-    cv_.x_q8 = 0;
-    uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
-    have_handover_ = false;
-    origin_ = 0;
-    prepare_profile(entry, spec.v_exit2, cv_.ref_um);
-    if (holding_) {
-        a_hold_ = prof_.a_entry;
-        x2_hold_ = 0;
-    }
-    active_ = true;
-    stopped_ = false;
-    seg_len_ = 1;
-    return true;
+    dv2_.set(spec.dv2);
+    if (!spec.dv2) dv2_.set(spec.len_q8).mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
 }
 
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
     const uint32_t d1 = ref_len();
-    // Fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
-    // l = v^2 rho / (2 a), rho = 1000 d_1 / len_um = 256000 d_1 / len_q8 ticks per mm.
-    Num phi(128000);
-    phi.mul(d1).div(len_q8_).div(accel_);
-    // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)), len_um = len_q8 / 256.
-    Num dn(len_q8_, -7);
-    dn.div(accel_).div(d1).sqrt().mul(kSqrtCHalf).shift(1);
-    // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 and D below 2^32
-    // (D grows as sqrt(s) = 2^m sqrt(2)).
+    // From psi = 1 / (dv2 d_1), one division (dv2 = 2 a L, a = 128000 dv2 / len_q8):
+    // fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
+    //   l = v^2 rho / (2 a), rho = 256000 d_1 / len_q8 ticks per mm, so phi = d_1 / dv2 = psi
+    //   d_1^2;
+    // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD len_q8 sqrt(psi),
+    //   kD = 2 kSqrtCHalf / sqrt(2^7 128000).
+    Num psi(d1);
+    psi.mul(dv2_);
+    {
+        Num one(1);
+        psi = one.div(psi);
+    }
+    Num phi = psi;
+    phi.mul(d1).mul(d1);
+    Num dn = psi;
+    dn.sqrt().mul(Num(len_q8_)).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
+    // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
+    // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
     uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);
     uint8_t m = 4;
-    while (m > 0 && (shl_sat(l_max, static_cast<uint8_t>(2 * m + 1)) > kMaxA ||
-                     Num(dn).shift(static_cast<int8_t>(m)).u32() == 0xFFFFFFFFul)) {
-        --m;
+    for (uint32_t lim = 1ul << 22; m > 0; --m, lim <<= 2) {
+        int8_t de = static_cast<int8_t>(dn.e + m); // D 2^m = dn.m 2^de
+        bool d_full = dn.m != 0 && (de > 0 || (de == 0 && dn.m == 0xFFFFFFFFul));
+        if (l_max <= lim && !d_full) break;
     }
     prof_.log_s = static_cast<uint8_t>(2 * m + 1);
     a_per_v2_ = phi.shift(static_cast<int8_t>(prof_.log_s));
     prof_.d = remaining_ticks;
-    prof_.a_entry = a_of(v_entry2);
+    // Chains of moves mostly enter and leave at their cruise speed: one product then.
     prof_.a_cruise = a_of(v_nominal2_);
-    prof_.a_exit = a_of(v_exit2);
+    prof_.a_entry = v_entry2 == v_nominal2_ ? prof_.a_cruise : a_of(v_entry2);
+    prof_.a_exit = v_exit2 == v_nominal2_ ? prof_.a_cruise : a_of(v_exit2);
     if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
-    prof_.cruise = Num(kCruiseNum).mul(len_q8_).div(feed_).div(d1).u32();
-    x2_decel_ = profile_x2_decel(prof_);
+    Num fd(feed_);
+    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(fd.mul(d1)).u32();
+    mark_profile();
     root_valid_ = false;
+    if (!curve_) {
+        // The runs' periods at cruise, for fill_line (one product per axis set and move).
+        const uint8_t sets = static_cast<uint8_t>(1u << (ln_.g.m - 1));
+        for (uint8_t sub = 0; sub < sets; ++sub) {
+            ln_.cruise_period[sub] = mul_shr(prof_.cruise, ln_.k[sub], 20);
+        }
+        ln_.cruise_seg = next_segment(prof_.cruise, mul_shr(prof_.cruise, ln_.kmax, 20));
+    }
+}
+
+void StepGen::mark_profile() {
+    // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
+    // A_cruise everywhere and the end deceleration starts at its end (what profile_x2_decel
+    // gives then). Chains of short moves are made of such moves.
+    cruising_ = prof_.a_entry == prof_.a_cruise && prof_.a_exit == prof_.a_cruise;
+    x2_decel_ = cruising_ ? 2 * prof_.d : profile_x2_decel(prof_);
 }
 
 void StepGen::set_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
+    if (v_exit2 == v_exit2_) return;                     // called at every poll: usually no change
     if (2 * (progress() - origin_) >= x2_decel_) return; // end deceleration already begun
     v_exit2_ = v_exit2;
     prof_.a_exit = a_of(v_exit2);
     if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
-    x2_decel_ = profile_x2_decel(prof_);
+    mark_profile();
 }
 
 void StepGen::hold() {
@@ -247,7 +281,7 @@ void StepGen::pushed_position(int32_t out[kAxes]) const {
     for (uint8_t j = 0; j < ln_.g.m; ++j) {
         uint8_t a = ln_.g.axis[j];
         int32_t p = static_cast<int32_t>(ln_.c.pos[j]);
-        out[a] += (ln_.g.dirs & (1u << a)) ? -p : p;
+        out[a] += ((ln_.g.dirs >> a) & 1) ? -p : p;
     }
 }
 
@@ -267,18 +301,34 @@ void StepGen::abort() {
 }
 
 uint32_t StepGen::queued_cycles(const RunQueue& q) {
+    horizon_full(q);
+    return static_cast<uint32_t>(queued_) << 10;
+}
+
+bool StepGen::horizon_full(const RunQueue& q) {
     // Runs the interrupt has taken since the last look no longer count.
     uint8_t head = q.head;
     while (seen_head_ != head) {
         queued_ = static_cast<uint16_t>(queued_ - slot_time_[seen_head_]);
         seen_head_ = static_cast<uint8_t>((seen_head_ + 1) & (kRunQueueSize - 1));
     }
-    return static_cast<uint32_t>(queued_) << 10;
+    // queued_cycles() >= kHorizonCycles, in the 1024-cycle units (no 32-bit shift)
+    return queued_ >= (kHorizonCycles + 1023) >> 10;
 }
 
 void StepGen::clear_queue_time() {
     queued_ = 0;
     seen_head_ = 0;
+}
+
+void StepGen::push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint16_t period,
+                   uint8_t units) {
+    slot_time_[q.tail] = units;
+    queued_ = static_cast<uint16_t>(queued_ + units);
+    q.push(Run{steps, dirs, count, period});
+#if LL_STATS
+    ++stats.runs;
+#endif
 }
 
 void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8) {
@@ -291,13 +341,10 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
     }
     if (period > kMaxPeriodCycles) period = kMaxPeriodCycles;
     if (period <= 0xFFFF) {
-        uint32_t units = (period * count) >> 10; // < 2^14
-        slot_time_[q.tail] = units > 255 ? 255 : static_cast<uint8_t>(units);
-        queued_ = static_cast<uint16_t>(queued_ + slot_time_[q.tail]);
-        q.push(Run{steps, dirs, count, static_cast<uint16_t>(period)});
-#if LL_STATS
-        ++stats.runs;
-#endif
+        // >> 10 as a byte move and two shifts (avr-gcc 5.4 makes a 10-turn loop of it)
+        uint32_t units = ((count == 1 ? period : period * count) >> 8) >> 2; // < 2^14
+        push(q, steps, dirs, count, static_cast<uint16_t>(period),
+             units > 255 ? 255 : static_cast<uint8_t>(units));
     } else {
         // Below 245 steps/s: each event is preceded by idle waits (steps == 0) so that every
         // compare value fits the 16-bit timer without changing its prescaler.
@@ -305,19 +352,18 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
         uint16_t each = static_cast<uint16_t>(period / parts);
         uint16_t last = static_cast<uint16_t>(period - (parts - 1) * each);
         for (uint8_t i = 0; i < count; ++i) {
-            slot_time_[q.tail] = 255;
-            q.push(Run{0, dirs, static_cast<uint8_t>(parts - 1), each});
-            slot_time_[q.tail] = 63;
-            q.push(Run{steps, dirs, 1, last});
-            queued_ = static_cast<uint16_t>(queued_ + 255 + 63);
-#if LL_STATS
-            stats.runs += 2;
-#endif
+            push(q, 0, dirs, static_cast<uint8_t>(parts - 1), each, 255);
+            push(q, steps, dirs, 1, last, 63);
         }
     }
 }
 
 bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
+    if (cruising_ && !holding_) {
+        a_last_ = prof_.a_cruise; // profile_a(x2) == a_cruise: no evaluation
+        delta = prof_.cruise;
+        return true;
+    }
     uint32_t a = profile_a(prof_, x2);
     if (holding_) {
         uint32_t dec = shl_sat(x2 - x2_hold_, static_cast<uint8_t>(prof_.log_s - 1));
@@ -341,7 +387,7 @@ bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
         changed = root_.seek(a);
     }
     if (changed) {
-        delta_root_ = prof_.d_num / (root_.r != 0 ? root_.r : 1);
+        delta_root_ = div32_16(prof_.d_num, static_cast<uint16_t>(root_.r != 0 ? root_.r : 1));
 #if LL_STATS
         ++stats.divisions;
 #endif
@@ -354,11 +400,10 @@ bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
 uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest) {
     uint8_t next = 1;
     if (longest <= 0xFFFF00ul) {
-        // delta * next, not target / next: a division here is a libgcc call (~600 cycles on the
-        // ATmega328P, up to 4 per segment). No overflow: delta <= longest < 2^24, next <= 8.
-        const uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8;
-        while (next < kMaxSegmentTicks && delta * next < target) {
+        uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8; // / next: a shift
+        while (next < kMaxSegmentTicks && delta < target) {
             next = static_cast<uint8_t>(next << 1);
+            target >>= 1;
         }
     }
     return next;
@@ -378,7 +423,7 @@ void StepGen::fill_line(RunQueue& q) {
         // Room for the worst case of one segment: m runs, each possibly split in two; and no
         // more than the horizon committed ahead of the interrupt.
         if (q.free_slots() < 2 * ln_.g.m) break;
-        if (queued_cycles(q) >= kHorizonCycles) break;
+        if (horizon_full(q)) break;
         uint32_t left = ln_.g.dist[0] - ln_.c.x1;
         uint8_t len = left < seg_len_ ? static_cast<uint8_t>(left) : seg_len_;
         uint32_t delta;
@@ -388,40 +433,56 @@ void StepGen::fill_line(RunQueue& q) {
         MicroRun runs[kAxes];
         uint8_t n = micro_split(e, ln_.g.m, runs);
         // The K table makes the micro steps of a segment last len x Delta_1 altogether when they
-        // are nested as in §8 (docs/motion.md, "Feed along the line"). A segment whose micro
-        // steps are not (a single tick at low speed, where the minor axes of a 3- or 4-axis line
-        // step on ticks of their own) sums to more or less. The difference is carried over and
-        // beyond a dead band of half a tick (within which the nested segments of 2-axis lines
-        // stay, and end exact) it scales the next segment's Delta_1, spread over its ticks: the
-        // waits keep the §3.2 proportions at a speed corrected per segment, and the feed along
-        // the whole line stays exact within about half a tick's time.
-        uint8_t sh = 0; // spread over the segment length in force (not a short last one)
-        while ((2u << sh) <= seg_len_) ++sh;
-        const int32_t band = 1l << 19;
-        int32_t over = ln_.k_err > band ? ln_.k_err - band : 0;
-        if (ln_.k_err < -band) over = ln_.k_err + band;
-        // Per tick, Q20 of the mean K (1.0): the next ticks last (1 - corr) as long.
-        int32_t corr = over >> sh;              // arithmetic shift
-        if (corr > (1l << 18)) corr = 1l << 18; // at most a quarter: no jolt
-        if (corr < -(1l << 18)) corr = -(1l << 18);
+        // are nested as in §8 (docs/motion.md, "Feed along the line"), which they always are
+        // with one or two moving axes. With three or four, a segment whose micro steps are not
+        // (a single tick at low speed, where the minor axes step on ticks of their own) sums to
+        // more or less. The difference is carried over and beyond a dead band of half a tick it
+        // scales the next segment's Delta_1, spread over its ticks: the waits keep the §3.2
+        // proportions at a speed corrected per segment, and the feed along the whole line stays
+        // exact within about half a tick's time.
+        const bool tracked = ln_.g.m > 2;
+        int32_t corr = 0; // per tick, Q20 of the mean K (1.0): the next ticks last (1 - corr)
+        if (tracked) {
+            uint8_t sh = 0; // spread over the segment length in force (not a short last one)
+            while ((2u << sh) <= seg_len_) ++sh;
+            const int32_t band = 1l << 19;
+            int32_t over = ln_.k_err > band ? ln_.k_err - band : 0;
+            if (ln_.k_err < -band) over = ln_.k_err + band;
+            corr = over >> sh;                      // arithmetic shift
+            if (corr > (1l << 18)) corr = 1l << 18; // at most a quarter: no jolt
+            if (corr < -(1l << 18)) corr = -(1l << 18);
+        }
         uint32_t d = delta;
         if (corr > 0) d -= mul_shr(delta, static_cast<uint32_t>(corr), 20);
         if (corr < 0) d += mul_shr(delta, static_cast<uint32_t>(-corr), 20);
+        // At cruise (most segments of a job) the periods are the move's constants.
+        const bool at_cruise = delta == prof_.cruise;
+        const bool constants = at_cruise && corr == 0;
         uint32_t sum = 0;
         for (uint8_t i = 0; i < n; ++i) {
             uint8_t idx = static_cast<uint8_t>(runs[i].set >> 1);
-            sum += runs[i].count * ln_.k[idx];
-            emit(q, ln_.mask[idx], ln_.g.dirs, runs[i].count, mul_shr(d, ln_.k[idx], 20));
+            if (tracked) sum += runs[i].count * ln_.k[idx];
+            emit(q, ln_.mask[idx], ln_.g.dirs, runs[i].count,
+                 constants ? ln_.cruise_period[idx] : mul_shr(d, ln_.k[idx], 20));
         }
-        // What this segment took, in K units of the uncorrected Delta_1: sum x (1 - corr).
-        int32_t took = static_cast<int32_t>(sum);
-        if (corr > 0) took -= static_cast<int32_t>(mul_shr(sum, static_cast<uint32_t>(corr), 20));
-        if (corr < 0) took += static_cast<int32_t>(mul_shr(sum, static_cast<uint32_t>(-corr), 20));
-        ln_.k_err += took - (static_cast<int32_t>(len) << 20);
+        if (tracked) {
+            // What this segment took, in K units of the uncorrected Delta_1: sum x (1 - corr).
+            int32_t took = static_cast<int32_t>(sum);
+            if (corr > 0)
+                took -= static_cast<int32_t>(mul_shr(sum, static_cast<uint32_t>(corr), 20));
+            if (corr < 0)
+                took += static_cast<int32_t>(mul_shr(sum, static_cast<uint32_t>(-corr), 20));
+            ln_.k_err += took - (static_cast<int32_t>(len) << 20);
+        }
 #if LL_STATS
         ++stats.segments;
 #endif
-        seg_len_ = next_segment(delta, mul_shr(delta, ln_.kmax, 20));
+        // A tick lasting kSegmentCycles already makes a one-tick segment, whatever the longest
+        // period: its product is only needed below that.
+        seg_len_ = at_cruise ? ln_.cruise_seg
+                   : delta >= static_cast<uint32_t>(kSegmentCycles) << 8
+                       ? 1
+                       : next_segment(delta, mul_shr(delta, ln_.kmax, 20));
         if (ln_.c.x1 == ln_.g.dist[0]) finish_move();
     }
 }
@@ -433,7 +494,7 @@ void StepGen::fill_curve(RunQueue& q) {
         const uint8_t free = q.free_slots();
         if (free < 4) break;
         const uint8_t cap = static_cast<uint8_t>((free - 2) / 2);
-        if (queued_cycles(q) >= kHorizonCycles) break;
+        if (horizon_full(q)) break;
         // The chord of the next sample sets the time of every sample of the segment (the
         // segment never crosses into the next piece, whose samples may be twice as long).
         int32_t d[3];
@@ -462,10 +523,10 @@ void StepGen::fill_curve(RunQueue& q) {
             uint8_t moved, neg;
             if (!cv_.w.next(moved, neg)) break;
             uint8_t steps = 0, dirs = 0;
-            for (uint8_t k = 0; k < 3; ++k) {
+            for (uint8_t k = 0; k < 3; ++k, moved >>= 1, neg >>= 1) {
                 uint8_t bit = static_cast<uint8_t>(1u << cv_.axes[k]);
-                if (moved & (1u << k)) steps = static_cast<uint8_t>(steps | bit);
-                if (neg & (1u << k)) dirs = static_cast<uint8_t>(dirs | bit);
+                if (moved & 1) steps = static_cast<uint8_t>(steps | bit);
+                if (neg & 1) dirs = static_cast<uint8_t>(dirs | bit);
             }
             if (run_count != 0 && (steps != run_steps || (steps && dirs != run_dirs))) {
                 emit(q, run_steps, run_dirs, run_count, period_q8);

@@ -15,8 +15,8 @@ void step_lengths_build(StepLengths& t, const uint32_t steps_per_unit_milli[kAxe
 
 uint32_t step_length(const StepLengths& t, uint8_t set) {
     Num sum{};
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        if (set & (1u << a)) sum.add(t.inv2[a]);
+    for (uint8_t a = 0; a < kAxes; ++a, set >>= 1) {
+        if (set & 1) sum.add(t.inv2[a]);
     }
     return sum.sqrt().shift(30).u32(); // Q30
 }

@@ -371,9 +371,33 @@ const FnList kPlannerFns = {
     {"_ZNK2ll7Planner13spec_of_firstEv", "Planner::spec_of_first"},
     {"_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "StepGen::begin"},
     {"_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE", "StepGen::fill"},
+    {"_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE", "StepGen::fill"},
     {"_ZN2ll3hal10serial_putEh", "hal::serial_put"},
     {"_ZN2ll3app8run_onceEv", "app::run_once (the whole main loop)"},
 };
+
+/// More functions to profile, from the environment: LLBENCH_PROFILE="sym1,sym2" (mangled
+/// names, shown as given).
+FnList extra_fns() {
+    FnList out;
+    const char* env = getenv("LLBENCH_PROFILE");
+    std::string s = env ? env : "";
+    size_t at = 0;
+    while (at < s.size()) {
+        size_t comma = s.find(',', at);
+        if (comma == std::string::npos) comma = s.size();
+        if (comma > at) out.push_back({s.substr(at, comma - at), s.substr(at, comma - at)});
+        at = comma + 1;
+    }
+    return out;
+}
+
+/// The circle's feed, mm/min: 3000 (the figure of the issue) unless LLBENCH_CIRCLE_FEED says
+/// otherwise (to look at the producer when it keeps up).
+double circle_feed() {
+    const char* env = getenv("LLBENCH_CIRCLE_FEED");
+    return env ? atof(env) : 3000;
+}
 
 // ---- circle of short segments -------------------------------------------------------------
 
@@ -404,14 +428,16 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
     CircleRun c;
     Board b(cfg.elf);
     b.settings({"$100=80", "$101=80", "$110=5000", "$111=5000", "$120=1000", "$121=1000"});
-    const std::vector<std::string> job = circle_job(radius, 0.1, 3000);
+    const std::vector<std::string> job = circle_job(radius, 0.1, circle_feed());
     c.lines = job.size();
     std::unique_ptr<Profiler> prof;
     const std::string kExecute = "_ZN2ll5gcode7executeEPKchRNS0_7OutcomeE";
     const std::string kAdd = "_ZN2ll7Planner3addEPKlS2_mb";
+    const std::string kPushLine = "_ZN2ll6motion9push_lineERKNS0_11LineRequestE";
     if (profile) {
         std::vector<std::string> syms;
         for (const auto& f : kPlannerFns) syms.push_back(f.first);
+        for (const auto& f : extra_fns()) syms.push_back(f.first);
         prof.reset(new Profiler(b.sim, syms));
         b.host.hook = [&] { prof->step(); };
     }
@@ -447,11 +473,15 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
         std::vector<bool> is_gen(kPlannerFns.size(), false);
         for (const char* g :
              {"_ZN2ll6motion4pollEv", "_ZNK2ll7Planner13spec_of_firstEv",
-              "_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE"}) {
+              "_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE",
+              "_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE"}) {
             const int k = prof->index_of(g);
             if (k >= 0) is_gen[static_cast<size_t>(k)] = true;
         }
-        const int fe = prof->index_of(kExecute), fa = prof->index_of(kAdd);
+        // Parse + plan of a line: gcode::execute (parse), then motion::push_line (plan), which
+        // the protocol calls after execute() returns; step generation taken out of both.
+        const int fe = prof->index_of(kExecute), fa = prof->index_of(kAdd),
+                  fp = prof->index_of(kPushLine);
         const std::vector<Profiler::Call>& calls = prof->calls();
         std::vector<uint64_t> exec_own(calls.size(), 0);
         std::vector<bool> queued(calls.size(), false);
@@ -461,14 +491,16 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
             const Profiler::Call& k = calls[i];
             if (!k.end || k.start < job_start) continue;
             const uint64_t own = prof->own_cycles(k);
-            if (k.fn == fe) exec_own[i] += own;
+            if (k.fn == fe || k.fn == fp) exec_own[i] += own;
             // The innermost enclosing execute, and whether step generation encloses this call.
             int p = -1;
             bool inside_gen = false;
             for (int q = k.parent; q >= 0; q = calls[static_cast<size_t>(q)].parent) {
                 if (is_gen[static_cast<size_t>(calls[static_cast<size_t>(q)].fn)])
                     inside_gen = true;
-                if (p < 0 && calls[static_cast<size_t>(q)].fn == fe) p = q;
+                if (p < 0 && (calls[static_cast<size_t>(q)].fn == fe ||
+                              calls[static_cast<size_t>(q)].fn == fp))
+                    p = q;
             }
             if (is_gen[static_cast<size_t>(k.fn)] && !inside_gen) {
                 poll_total += own;
@@ -479,10 +511,14 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
                 if (p >= 0) queued[static_cast<size_t>(p)] = true;
             }
         }
+        uint64_t last_parse = 0; // the execute() that produced the move push_line plans
         for (size_t i = 0; i < calls.size(); ++i) {
-            if (calls[i].fn != fe || !calls[i].end || calls[i].start < job_start) continue;
+            if ((calls[i].fn != fe && calls[i].fn != fp) || !calls[i].end ||
+                calls[i].start < job_start)
+                continue;
             all_exec += exec_own[i];
-            if (queued[i]) per_call.push_back(exec_own[i]);
+            if (calls[i].fn == fe) last_parse = exec_own[i];
+            if (queued[i]) per_call.push_back(last_parse + exec_own[i]);
         }
         c.accepted_calls = per_call.size();
         c.parse_plan = stats_of(per_call);
@@ -499,7 +535,9 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
         }
         c.isr_share = static_cast<double>(isr) / motion_cycles;
         c.compa = stats_of(a_spans);
-        c.costs = costs_of(*prof, kPlannerFns, job_start);
+        FnList fns = kPlannerFns;
+        for (const auto& f : extra_fns()) fns.push_back(f);
+        c.costs = costs_of(*prof, fns, job_start);
         c.window = static_cast<double>(std::max(t.last(), b.sim.cycle()) - job_start);
     }
     return c;
@@ -521,7 +559,8 @@ void print_circle(const char* label, const CircleRun& c, double ideal) {
         static_cast<unsigned long long>(c.steps[1]),
         c.back_at_start ? "back at the start" : "NOT back at the start", c.starvations);
     if (c.profiled) {
-        std::cout << fmt("  parse + plan per G1 line (gcode::execute, without step generation and "
+        std::cout << fmt("  parse + plan per G1 line (gcode::execute + motion::push_line, without "
+                         "step generation and "
                          "interrupts): median %llu, min %llu, max %llu cycles over %zu lines; "
                          "%.0f per line sent, retries included\n",
                          static_cast<unsigned long long>(c.parse_plan.median),
@@ -594,6 +633,10 @@ std::vector<FnCost> producer_profile(const Config& cfg, double rate, double mm, 
         {"__mulsi3", "__mulsi3"},
         {"_ZN2ll7StepGen8set_exitEm", "StepGen::set_exit"},
         {"_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "StepGen::begin"},
+        // The same with a 16-run queue (config.h kRunQueueSize).
+        {"_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE", "StepGen::fill"},
+        {"_ZN2ll7StepGen4emitERNS_7RunRingILh16EEEhhhm", "StepGen::emit"},
+        {"_ZN2ll7StepGen13queued_cyclesERKNS_7RunRingILh16EEE", "StepGen::queued_cycles"},
     };
     Board b(cfg.elf);
     b.settings({"$0=3", "$100=1000", "$110=300000", "$120=2000", "G91"});
@@ -612,6 +655,16 @@ std::vector<FnCost> producer_profile(const Config& cfg, double rate, double mm, 
     const Trace t = trace_steps(b.sim);
     *motion_cycles = static_cast<double>(t.last() - t.first());
     std::vector<FnCost> out = costs_of(prof, fns, t0);
+    // The same function under another queue size (RunRing<16>, RunRing<32>): one row.
+    for (size_t i = 0; i < out.size(); ++i) {
+        for (size_t j = i + 1; j < out.size(); ++j) {
+            if (out[j].name != out[i].name) continue;
+            out[i].calls += out[j].calls;
+            out[i].cycles += out[j].cycles;
+            out[j].calls = 0;
+            out[j].cycles = 0;
+        }
+    }
     *segments = out[2].calls;
     return out;
 }
@@ -758,7 +811,7 @@ int main(int argc, char** argv) {
     }
 
     if (cfg.want("circle")) {
-        const double radius = cfg.quick ? 1 : 10, v = 50.0, acc = 1000.0;
+        const double radius = cfg.quick ? 1 : 10, v = circle_feed() / 60, acc = 1000.0;
         const double ideal = 2 * kPi * radius / v + v / acc;
         std::cout << fmt("\n## Circle r = %g mm of 0.1 mm G1 segments, F3000, 80 steps/mm, "
                          "1000 mm/s², 115200 baud\n",

@@ -18,7 +18,7 @@ static_assert(kAxes >= 1 && kAxes <= 6, "Low Level drives 1 to 6 axes");
 constexpr uint32_t kCpuHz = 16000000UL;
 
 /// Capacity of the run queue between the producer (main loop) and the step interrupt.
-constexpr uint8_t kRunQueueSize = 32;
+constexpr uint8_t kRunQueueSize = 16;
 static_assert((kRunQueueSize & (kRunQueueSize - 1)) == 0, "power of two");
 
 /// Blocks in the look-ahead planner ring.

@@ -23,8 +23,19 @@ uint16_t isqrt32(uint32_t v);
 /// Preconditions: 0 < den < 2^31 and the quotient fits in 32 bits.
 uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits);
 
+/// The full product a * b = hi * 2^32 + lo: returns hi, writes lo. On the ATmega328P, 16
+/// hardware 8x8 multiplications summed column by column (about 90 cycles, no library call).
+uint32_t mul_wide(uint32_t a, uint32_t b, uint32_t& lo);
+
+/// floor((hi * 2^32 + lo) / 2^shift), saturated to 2^32 - 1 (shift <= 63).
+uint32_t shr64_sat(uint32_t hi, uint32_t lo, uint8_t shift);
+
 /// floor(a * b / 2^shift), saturated to 2^32 - 1 (shift <= 63).
 uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift);
+
+/// floor(n / d) for a 16-bit divisor d != 0 (the step generator's D / R): 32 turns of a 17-bit
+/// remainder on the ATmega328P instead of the library's 32-bit one.
+uint32_t div32_16(uint32_t n, uint16_t d);
 
 /// min(x << k, 2^32 - 1).
 uint32_t shl_sat(uint32_t x, uint8_t k);
@@ -51,6 +62,13 @@ int32_t atan2_q29(int32_t y, int32_t x);
 /// 2^-30 (no table): used where an arc is prepared, never per step.
 void small_angle_q30(int32_t h, int32_t& c, int32_t& s, int32_t& k);
 
+/// Sum of the squares of the n values whose bit is set in `mask` (bit i for v[i]), as a Num
+/// (exact 64-bit sums; truncated to 32 bits once).
+struct Num;
+Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask = 0xFF);
+/// (hi * 2^32 + lo) * 2^exp as a Num, truncated; exp <= 95.
+Num num64(uint32_t hi, uint32_t lo, int8_t exp = 0);
+
 /// value = m * 2^e, m normalised to [2^31, 2^32) (or m == 0 for zero).
 struct Num {
     uint32_t m;
@@ -62,6 +80,9 @@ struct Num {
     Num& set(uint32_t v, int8_t exp = 0); ///< v * 2^exp
     Num& mul(const Num& o);
     Num& mul(uint32_t v);
+    /// Multiplies by the constant mant * 2^exp, given normalised (mant >= 2^31): constants as
+    /// immediate operands (a constant Num object would be copied from RAM on the ATmega328P).
+    Num& mulc(uint32_t mant, int8_t exp);
     Num& div(const Num& o); ///< o != 0
     Num& div(uint32_t v);   ///< v != 0
     Num& add(const Num& o);

@@ -20,13 +20,19 @@ constexpr uint32_t kMaxLineTicks = (1ul << 23) - 1;
 /// Longest macro segment (reference-axis ticks between two computed positions).
 constexpr uint8_t kMaxSegmentTicks = 16;
 
+/// Fixed-point unit of slopes and fractions: 2^kLineUnit stands for one tick, whatever k (k <=
+/// 26 < kLineUnit), so that line_advance() shifts by a constant (a variable shift is a loop on
+/// the ATmega328P) and S_j * 16 + P stays within 32 bits.
+constexpr uint8_t kLineUnit = 27;
+
 struct LineGeometry {
-    uint8_t m;             ///< moving axes
-    uint8_t shift;         ///< k, with 2^k >= 8 * dist[0]
-    uint8_t dirs;          ///< machine-axis bits travelling towards negative coordinates
-    uint8_t axis[kAxes];   ///< machine axis at each sorted position (0 = reference axis)
-    uint32_t dist[kAxes];  ///< ticks to travel at each sorted position, decreasing
-    uint32_t slope[kAxes]; ///< S_j = round(dist[j] * 2^k / dist[0]); slope[0] = 2^k
+    uint8_t m;            ///< moving axes
+    uint8_t shift;        ///< k, with 2^k >= 8 * dist[0]
+    uint8_t dirs;         ///< machine-axis bits travelling towards negative coordinates
+    uint8_t axis[kAxes];  ///< machine axis at each sorted position (0 = reference axis)
+    uint32_t dist[kAxes]; ///< ticks to travel at each sorted position, decreasing
+    /// S_j = round(dist[j] * 2^k / dist[0]) in units of 2^(kLineUnit - k) (slope[0]: one tick)
+    uint32_t slope[kAxes];
 };
 
 /// Sets up the line from the per-axis deltas (ticks). Returns false for a zero-length line or
@@ -37,7 +43,7 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]);
 struct LineCursor {
     uint32_t x1;          ///< reference-axis ticks travelled
     uint32_t pos[kAxes];  ///< ticks travelled at each sorted position
-    uint32_t frac[kAxes]; ///< fractional part of S_j * x_1 + P/2, k bits
+    uint32_t frac[kAxes]; ///< fractional part of S_j * x_1 + P/2, k bits, in kLineUnit units
 };
 
 void line_start(const LineGeometry& g, LineCursor& c);

@@ -3,9 +3,9 @@
 // from, recomputed as moves arrive (backward then forward pass). Speeds are squared, in
 // (units/min)^2 of each move's regulated path (seed §3.1); integer only.
 //
-// A queued move costs 29 bytes of RAM (16 of them fit in the ATmega328P's budget): deltas are
-// kept on 24 bits, and what can be derived from them again (length, acceleration limit) is
-// recomputed when the move starts instead of being stored.
+// A queued move costs 33 bytes of RAM: deltas are kept on 24 bits; the length is kept (the step
+// generator needs it when the move starts, and recomputing it took a square root per move) and
+// the acceleration is derived from dv2 and the length instead of being stored.
 #pragma once
 
 #include "lowlevel/machine.h"
@@ -21,6 +21,7 @@ struct PlanBlock {
     uint8_t group;           ///< regulated axes (seed §3.1)
     uint8_t curve;           ///< 0: a straight move; else 1 + the slot of its curve
     uint32_t feed;           ///< nominal speed, units/min x1000
+    uint32_t len_q8;         ///< length of the regulated path, µm x 256 (for the step generator)
     uint32_t dv2;            ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
     uint32_t v_entry2;       ///< planned entry speed squared
     uint32_t v_max_entry2;   ///< junction and nominal limit on the entry speed squared
@@ -88,8 +89,11 @@ class Planner {
 
   private:
     uint8_t index(uint8_t i) const { return static_cast<uint8_t>((head_ + i) % kPlannerSize); }
-    void recalculate();
-    uint32_t junction2(const int32_t unit[kAxes]) const;
+    /// The look-ahead passes; `all`: do not stop where nothing changes (after a restart).
+    void recalculate(bool all = false);
+    /// Junction speed squared with the previous move, or any value >= `limit` when it is at
+    /// least that (the caller takes the minimum).
+    uint32_t junction2(const int32_t unit[kAxes], uint32_t limit) const;
 
     void finish_block(PlanBlock& b, const int32_t unit_in[kAxes], const int32_t unit_out[kAxes]);
 

@@ -47,12 +47,11 @@ uint32_t profile_x2_decel(const Profile& p);
 /// s d < 2^31 (the step generator picks s so).
 uint32_t profile_a(const Profile& p, uint32_t x2);
 
-/// The integer square root that follows A (seed §8.2), with C = R^2 and the next square kept
-/// so that a step of R costs an addition.
+/// The integer square root that follows A (seed §8.2), with C = R^2 kept so that a step of R
+/// costs two additions.
 struct SqrtTracker {
-    uint32_t r;      ///< floor(sqrt(A))
-    uint32_t c;      ///< r^2
-    uint32_t c_next; ///< (r + 1)^2
+    uint32_t r; ///< floor(sqrt(A))
+    uint32_t c; ///< r^2
 
     void reset(uint32_t a);
     /// Moves R to floor(sqrt(a)) one square at a time (a full square root after a jump).

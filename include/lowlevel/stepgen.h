@@ -38,12 +38,15 @@ constexpr uint32_t kMaxPeriodCycles = 256ul * 65000;
 struct MoveSpec {
     int32_t delta[kAxes]; ///< ticks per machine axis
     uint32_t len_q8;      ///< length of the regulated path (axes of `group`), µm x 256
-    uint32_t accel;       ///< acceleration along the regulated path, mm/min^2
-    uint32_t feed;        ///< nominal speed along the regulated path, mm/min x1000
-    uint32_t v_entry2;    ///< entry speed squared, (mm/min)^2
-    uint32_t v_nominal2;  ///< nominal speed squared, (mm/min)^2
-    uint32_t v_exit2;     ///< exit speed squared, (mm/min)^2
-    uint8_t group;        ///< regulated axes G (bit a = machine axis a)
+    uint32_t accel;       ///< acceleration along the regulated path, mm/min^2 (unless dv2)
+    /// 2 a L along the path, (mm/min)^2, as the planner has it (0: from len_q8 and accel). The
+    /// profile is derived from it directly, which spares a division.
+    uint32_t dv2;
+    uint32_t feed;       ///< nominal speed along the regulated path, mm/min x1000
+    uint32_t v_entry2;   ///< entry speed squared, (mm/min)^2
+    uint32_t v_nominal2; ///< nominal speed squared, (mm/min)^2
+    uint32_t v_exit2;    ///< exit speed squared, (mm/min)^2
+    uint8_t group;       ///< regulated axes G (bit a = machine axis a)
     /// The curve followed from the current position to `delta` further, or nullptr for a line.
     /// Must stay valid until the move is fully produced (the planner keeps it in a slot).
     const CurveParams* curve;
@@ -131,9 +134,19 @@ class StepGen {
   private:
     bool begin_curve(const MoveSpec& spec);
     void prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks);
+    void take_spec(const MoveSpec& spec);
+    /// What begin() and begin_curve() share: the speeds and the profile over `ticks`.
+    bool start_profile(const MoveSpec& spec, uint32_t ticks);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
+    /// Sets x2_decel_ and cruising_ from prof_.
+    void mark_profile();
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
+    /// queued_cycles(q) >= kHorizonCycles.
+    bool horizon_full(const RunQueue& q);
+    /// Queues one run and counts its duration (1024-cycle units) in the horizon.
+    void push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint16_t period,
+              uint8_t units);
     /// Delta_1 (cycles x 256 per reference unit) at half-unit position x2; false when a hold
     /// brings the speed to zero before x2.
     bool delta_at(uint32_t x2, uint32_t& delta);
@@ -156,6 +169,8 @@ class StepGen {
     bool stopped_;
     bool have_handover_;
     bool root_valid_;
+    bool lens_valid_; ///< ln_.lens holds step lengths (no curve ran since, same settings)
+    bool cruising_;   ///< the profile is at cruise from end to end (mark_profile())
     uint8_t seg_len_;
     uint8_t seen_head_;
     uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
@@ -172,7 +187,8 @@ class StepGen {
     SqrtTracker root_;
     Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
     // What remains needed of the MoveSpec after begin().
-    uint32_t len_q8_, accel_, feed_, v_nominal2_, v_exit2_;
+    uint32_t len_q8_, feed_, v_nominal2_, v_exit2_;
+    Num dv2_; ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
     // The move being produced: a line or a curve, never both, so they share their memory.
@@ -184,6 +200,12 @@ class StepGen {
         int32_t k_err; ///< K-time emitted beyond len x Delta_1 so far, Q20 (see fill_line)
         uint32_t k[1u << (kAxes - 1)];   ///< K table, Q20 (see k())
         uint8_t mask[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
+        // Step length of each sorted set (restricted to the regulated group), kept from one
+        // line to the next while lens_valid_: in the room the curve state leaves.
+        uint32_t lens[1u << (kAxes - 1)];
+        uint8_t lens_set[1u << (kAxes - 1)];       ///< the axis set each length is for
+        uint32_t cruise_period[1u << (kAxes - 1)]; ///< K * Delta_1 at cruise, cycles x 256
+        uint8_t cruise_seg;                        ///< segment length at cruise
     };
     struct CurveState {
         CurveWalker w;

@@ -1,0 +1,99 @@
+// The same pseudo-random workload of fixmath.h's operations, hashed, on the host and on the
+// ATmega328P (firmware/fixmath_check.cpp): the AVR assembly paths (mul_wide, the division and
+// square root loops) must give exactly the results of the portable C that the host tests check.
+#pragma once
+
+#include <stdint.h>
+
+#include "lowlevel/fixmath.h"
+
+namespace ll {
+namespace check {
+
+struct Hash {
+    uint32_t h = 2166136261ul;
+    void add(uint32_t v) {
+        for (uint8_t i = 0; i < 4; ++i) {
+            h = (h ^ (v & 0xFF)) * 16777619ul;
+            v >>= 8;
+        }
+    }
+    void add(const Num& n) {
+        add(n.m);
+        add(static_cast<uint32_t>(static_cast<uint8_t>(n.e)));
+    }
+};
+
+inline uint32_t xorshift(uint32_t& s) {
+    s ^= s << 13;
+    s ^= s >> 17;
+    s ^= s << 5;
+    return s;
+}
+
+/// A value of any magnitude: the top bits cleared at random.
+inline uint32_t any(uint32_t& s) {
+    uint32_t v = xorshift(s);
+    return v >> (xorshift(s) & 31);
+}
+
+inline Num any_num(uint32_t& s) {
+    uint32_t m = any(s) | 1;
+    int8_t e = static_cast<int8_t>(static_cast<int16_t>(xorshift(s) % 60) - 30);
+    return Num(m, e);
+}
+
+inline uint32_t fixmath_hash(uint16_t rounds) {
+    Hash h;
+    uint32_t s = 0x12345678ul;
+    for (uint16_t i = 0; i < rounds; ++i) {
+        uint32_t a = any(s), b = any(s);
+        uint32_t lo, hi = mul_wide(a, b, lo);
+        h.add(hi);
+        h.add(lo);
+        h.add(mul_shr(a, b, static_cast<uint8_t>(xorshift(s) & 63)));
+        h.add(isqrt32(a));
+        uint32_t den = (b & 0xFFFFFF) | 1;
+        uint32_t num = a % (den + 1);
+        h.add(div_frac(num, den, static_cast<uint8_t>(20 + (xorshift(s) & 7))));
+        Num x = any_num(s), y = any_num(s);
+        Num p = x, q = x, r = x, t = x;
+        p.mul(y);
+        q.div(y);
+        r.sqrt();
+        t.add(y);
+        h.add(p);
+        h.add(q);
+        h.add(r);
+        h.add(t);
+        h.add(x.u32());
+        h.add(x.of(b));
+        h.add(Num(a).div(b | 1).of(a));
+        h.add(static_cast<uint32_t>(x.cmp(y)));
+        h.add(num64(any(s), any(s),
+                    static_cast<int8_t>(static_cast<int16_t>(xorshift(s) % 80) - 40)));
+        uint32_t v[4] = {any(s), any(s), 0, any(s) >> (xorshift(s) & 7)};
+        h.add(sum_squares(v, 4));
+        h.add(div32_16(any(s), static_cast<uint16_t>((any(s) & 0xFFFF) | 1)));
+        // Zeros and equal exponents.
+        Num z(0), w = x;
+        w.e = y.e;
+        h.add(static_cast<uint32_t>(z.cmp(x)) ^ static_cast<uint32_t>(x.cmp(z)) << 8 ^
+              static_cast<uint32_t>(z.cmp(z)) << 16 ^ static_cast<uint32_t>(w.cmp(y)) << 24);
+        Num u = z, v2 = x;
+        h.add(u.add(x));
+        h.add(v2.add(z));
+        h.add(w.add(y));
+        h.add(z.mul(x));
+        h.add(Num(x).div(z));
+        h.add(Num(x).mul(b));
+        h.add(Num(a | 1, static_cast<int8_t>(-40 - static_cast<int8_t>(xorshift(s) & 31))).of(b));
+        h.add(z.of(b) ^ x.of(0));
+        h.add(Num(y).mul(b >> (xorshift(s) & 31)));
+        h.add(Num(y).div(a >> (xorshift(s) & 31)));
+    }
+    return h.h;
+}
+
+} // namespace check
+} // namespace ll
