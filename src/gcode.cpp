@@ -380,19 +380,21 @@ bool word_um(const Block& b, uint8_t word, int32_t dflt, int32_t& out) {
 // normal axis' travel `dw_um` too. (A function of its own: a small stack frame.)
 __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_t ax[3],
                                               int32_t dw_um) {
-    uint32_t reach = 0; // length bound, um / 2
+    Num reach{}; // length bound, um
     for (uint8_t k = 0; k < 2; ++k) {
-        const int32_t pts[4] = {c.start_um[k], c.end_um[k], c.a_um[k], c.b_um[k]};
-        for (int32_t p : pts) {
+        const int32_t* const pts[4] = {c.start_um, c.end_um, c.a_um, c.b_um};
+        for (uint8_t i = 0; i < 4; ++i) {
             int32_t steps;
-            if (!num::mul_div_round(p, g_settings.axis[ax[k]].steps_per_unit, 1000000u, steps) ||
+            if (!num::mul_div_round(pts[i][k], g_settings.axis[ax[k]].steps_per_unit, 1000000u,
+                                    steps) ||
                 abs32(steps) > (1l << 22)) {
                 return false;
             }
         }
         if (c.kind == kCurveBezier) {
-            reach += abs32(c.a_um[k] - c.start_um[k]) / 2 + abs32(c.b_um[k] - c.a_um[k]) / 2 +
-                     abs32(c.end_um[k] - c.b_um[k]) / 2;
+            reach.add(Num(abs32(c.a_um[k] - c.start_um[k])))
+                .add(Num(abs32(c.b_um[k] - c.a_um[k])))
+                .add(Num(abs32(c.end_um[k] - c.b_um[k])));
         }
     }
     if (c.kind == kCurveArc) {
@@ -402,14 +404,12 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
         ellipse_direction(c.start_um[0] - c.a_um[0], c.start_um[1] - c.a_um[1], radii, c0, s0);
         ellipse_direction(c.end_um[0] - c.a_um[0], c.end_um[1] - c.a_um[1], radii, c1, s1);
         int64_t sweep = arc_sweep_q29(c0, s0, c1, s1, c.clockwise != 0, c.turns);
-        uint64_t mag = static_cast<uint64_t>(sweep < 0 ? -sweep : sweep);
-        uint32_t r = radii[0] > radii[1] ? radii[0] : radii[1];
-        // r |sweep| / 2, |sweep| < 2^40 (Q29, 256 turns), r < 2^31.
-        uint64_t half = (static_cast<uint64_t>(r) * (mag >> 14)) >> 16;
-        reach = half > 0xFFFFFFFFull ? 0xFFFFFFFFul : static_cast<uint32_t>(half);
+        // |sweep| < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r |sweep|.
+        uint32_t q21 = static_cast<uint32_t>((sweep < 0 ? -sweep : sweep) >> 8);
+        reach.set(radii[0] > radii[1] ? radii[0] : radii[1]).mul(Num(q21, -21));
     }
-    reach += abs32(dw_um) / 2;
-    return reach < (1ul << 22);
+    reach.add(Num(abs32(dw_um)));
+    return reach.cmp(Num(1, 23)) < 0;
 }
 
 // Stage 3 of a curve (docs/curves.md): the checks and errors of GRBL's arcs (26 32 33 34 35), our
