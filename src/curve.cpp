@@ -4,14 +4,14 @@
 #include "lowlevel/pgm.h"
 
 // Size on the ATmega328P: every 64-bit addition, shift or product is a library call wrapped in
-// long register moves, and every Num operation a call sequence. So the few such operations are
-// written once, in the out-of-line helpers below, and the three axes are loops, not copies.
+// long register moves, and every Num operation a call sequence. So these operations are written
+// once, in the out-of-line helpers below, and the axes are loops, not copies.
 
 namespace ll {
 namespace {
 
-constexpr int32_t kOneQ30 = 1l << 30;
 constexpr int32_t kOneQ29 = 1l << 29;
+constexpr uint32_t kTurnQ29 = 2ul * kPiQ29;
 // Pieces of an arc are at most 21.5 degrees (their cubic is within 7e-8 R of the ellipse) and at
 // most this many ticks long, so that N <= 4096 samples keep the forward-difference error below
 // 0.02 tick.
@@ -22,10 +22,11 @@ __attribute__((noinline)) int32_t mul_q30(int32_t a, int32_t b) {
     return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> 30);
 }
 
-// x / 3, exactly (truncated towards zero as `/` does), by a multiplication: no division routine.
-__attribute__((noinline)) int32_t third(int32_t x) {
-    int32_t q = static_cast<int32_t>((static_cast<uint64_t>(abs32(x)) * 0xAAAAAAABull) >> 33);
-    return x < 0 ? -q : q;
+// Forward differences in place: (p0, p1, p2, p3) -> (p0, p1 - p0, p2 - 2 p1 + p0, p3 - 3 p2 + ...).
+void differences(int32_t q[4]) {
+    for (uint8_t i = 1; i < 4; ++i) {
+        for (uint8_t j = 3; j >= i; --j) q[j] -= q[j - 1];
+    }
 }
 
 // Taylor coefficients (Q30) of cos x, sin x / x and tan x / x as polynomials in x^2, with the
@@ -45,18 +46,18 @@ int32_t series(uint8_t which, int32_t y) {
     return r;
 }
 
-// cos h and sin h for |h| <= 0.4 rad, all Q30.
-void rotation(int32_t h, int32_t& c, int32_t& s) {
+// rot = (cos h, sin h) for |h| <= 0.4 rad, Q30.
+void rotation(int32_t h, int32_t rot[2]) {
     int32_t y = -mul_q30(h, h);
-    c = series(0, y);
-    s = mul_q30(h, series(1, y));
+    rot[0] = series(0, y);
+    rot[1] = mul_q30(h, series(1, y));
 }
 
-// (c, s) turned by the angle whose cosine and sine are (rc, rs), Q30.
-void rotate(int32_t& c, int32_t& s, int32_t rc, int32_t rs) {
-    int32_t cn = mul_q30(c, rc) - mul_q30(s, rs);
-    s = mul_q30(s, rc) + mul_q30(c, rs);
-    c = cn;
+// v = (cos t, sin t) turned by the angle of rot, Q30.
+void rotate(int32_t v[2], const int32_t rot[2]) {
+    int32_t c = mul_q30(v[0], rot[0]) - mul_q30(v[1], rot[1]);
+    v[1] = mul_q30(v[1], rot[0]) + mul_q30(v[0], rot[1]);
+    v[0] = c;
 }
 
 // sqrt(a^2 + b^2 + cc).
@@ -66,33 +67,40 @@ Num hypot(Num a, Num b, const Num& cc) {
     return a.add(b).add(cc).sqrt();
 }
 
-// A 64-bit magnitude as a Num (truncated to its 32 leading bits).
-Num num64(uint64_t v) {
-    int8_t e = 0;
-    while (v >> 32) {
-        v >>= 1;
-        ++e;
-    }
-    return Num(static_cast<uint32_t>(v), e);
-}
-
 // num / den as a signed fixed-point value with `bits` fraction bits, at most 1 in magnitude.
-int32_t unit_part(Num num, const Num& den, bool negative, uint8_t bits) {
+__attribute__((noinline)) int32_t unit_part(Num num, const Num& den, bool negative, uint8_t bits) {
     uint32_t u = num.div(den).shift(static_cast<int8_t>(bits)).u32();
     if (u > (1ul << bits)) u = 1ul << bits;
     return negative ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
 }
 
-// v[0..2] = (x, y, z) / |(x, y, z)|, Q29, from magnitudes and sign bits (1 = x, 2 = y, 4 = z).
-void unit3(const Num m[3], uint8_t negative, int32_t out[3]) {
-    Num zz = m[2];
-    Num n = hypot(m[0], m[1], zz.mul(m[2]));
-    for (uint8_t k = 0; k < 3; ++k) {
-        out[k] = n.m ? unit_part(m[k], n, (negative >> k) & 1, 29) : 0;
+// |sweep| in (0, 2 pi] from the angle a0 to the angle a1 (radians x 2^29, in (-pi, pi]),
+// clockwise or not: a closed arc is a full turn. The difference is taken modulo 2^32, where the
+// result (below 2^32) is exact.
+uint32_t sweep_q29(int32_t a0, int32_t a1, bool clockwise) {
+    if (clockwise) {
+        int32_t t = a0;
+        a0 = a1;
+        a1 = t;
     }
+    uint32_t d = static_cast<uint32_t>(a1) - static_cast<uint32_t>(a0);
+    return a1 > a0 ? d : d + kTurnQ29;
 }
 
-// Updates a position by one sample: the bit of the axis in `moved` (and `neg` when it goes down).
+// Directions (cos t, sin t) of an arc's start and end seen from its centre in the ellipse's
+// scale (Q30), and its sweep without the extra turns (radians x 2^29).
+uint32_t arc_directions(const int32_t start[2], const int32_t end[2], const int32_t centre[2],
+                        const uint32_t radii[2], bool clockwise, int32_t dir[2][2]) {
+    const int32_t* pt[2] = {start, end};
+    int32_t a[2];
+    for (uint8_t i = 0; i < 2; ++i) {
+        ellipse_direction(pt[i][0] - centre[0], pt[i][1] - centre[1], radii, dir[i][0], dir[i][1]);
+        a[i] = atan2_q29(dir[i][1], dir[i][0]);
+    }
+    return sweep_q29(a[0], a[1], clockwise);
+}
+
+// Sets `pos` to p, with the bit of the axis in `moved` (and in `neg` when it goes down).
 void move_to(int32_t& pos, int32_t p, uint8_t bit, uint8_t& moved, uint8_t& neg) {
     if (p == pos) return;
     moved = static_cast<uint8_t>(moved | bit);
@@ -107,14 +115,18 @@ __attribute__((noinline)) void fd_step(int64_t v[4]) {
     v[2] += v[3];
 }
 
-// x / 2^s in Q40 for x in Q8 (s <= 36): exact for s <= 32, floored beyond.
-__attribute__((noinline)) int64_t q40(int32_t x, uint8_t s) {
-    return (static_cast<int64_t>(x) << 32) >> s;
+// acc += x / 2^s in Q40 for x in Q8 (s <= 36): exact for s <= 32, floored beyond.
+__attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s) {
+    acc += (static_cast<int64_t>(x) << 32) >> s;
 }
 
-// ((b a) >> 20) + add: one step of Horner's rule with a in [0, 1] as Q20.
-__attribute__((noinline)) int64_t horner(int64_t b, uint32_t a_q20, int64_t add) {
-    return ((b * a_q20) >> 20) + add;
+// x + (y - x) a = (x (2^20 - a) + y a) / 2^20 (floored), a in [0, 1] as Q20: one step of de
+// Casteljau's algorithm, exact in 64 bits.
+__attribute__((noinline)) int32_t lerp(int32_t x, int32_t y, uint32_t a_q20) {
+    return static_cast<int32_t>(
+        (static_cast<int64_t>(x) * static_cast<int32_t>((1ul << 20) - a_q20) +
+         static_cast<int64_t>(y) * static_cast<int32_t>(a_q20)) >>
+        20);
 }
 
 } // namespace
@@ -131,66 +143,72 @@ void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], i
 
 int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clockwise,
                       uint8_t turns) {
-    int64_t sweep = static_cast<int64_t>(atan2_q29(s1, c1)) - atan2_q29(s0, c0); // (-2 pi, 2 pi)
-    const int64_t turn = clockwise ? -2ll * kPiQ29 : 2ll * kPiQ29;
-    uint16_t k = turns;
-    if (clockwise ? sweep >= 0 : sweep <= 0) ++k; // a closed arc is a full turn
-    while (k--) sweep += turn;
-    return sweep;
+    int64_t sweep =
+        static_cast<int64_t>(sweep_q29(atan2_q29(s0, c0), atan2_q29(s1, c1), clockwise) +
+                             static_cast<uint64_t>(turns) * kTurnQ29);
+    return clockwise ? -sweep : sweep;
 }
 
 void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
     for (uint8_t a = 0; a < 3; ++a) {
         pos[a] = e.start[a];
         end_[a] = e.end[a];
+        prev_q8_[a] = a < 2 ? p0_q8[a] : e.start[2] * 256;
     }
     // w moves linearly along the curve (a helix); without it, only u and v are walked.
-    w0_q8_ = e.start[2] * 256;
-    dw_q8_ = (e.end[2] - e.start[2]) * 256;
+    w0_q8_ = prev_q8_[2];
+    dw_q8_ = e.end[2] * 256 - w0_q8_;
     axes_ = dw_q8_ ? 3 : 2;
-    prev_q8_[0] = p0_q8[0];
-    prev_q8_[1] = p0_q8[1];
-    prev_q8_[2] = w0_q8_;
     kind_ = kind;
     left_ = 0;
 }
 
-void CurveWalker::start_piece(const int32_t p[4][3]) {
-    // Polynomial of the piece relative to its start (ticks x 256): d1 t + d2 t^2 + d3 t^3.
-    int32_t d[3][3];
+void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const int32_t arm3[3]) {
+    // The cubic from prev_q8_ (p0) to p3 whose control points are p0 + arm0 / 3 and
+    // p3 - arm3 / 3, ticks x 256: relative to p0, c1 t + c2 t^2 + c3 t^3 with c1 = arm0,
+    // c2 = 3 D - 2 arm0 - arm3, c3 = arm0 + arm3 - 2 D, D = p3 - p0.
+    int32_t c[3][3];
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
     for (uint8_t a = 0; a < 3; ++a) {
-        d[a][0] = 3 * (p[1][a] - p[0][a]);
-        d[a][1] = 3 * (p[0][a] - 2 * p[1][a] + p[2][a]);
-        d[a][2] = p[3][a] - p[0][a] + 3 * (p[1][a] - p[2][a]);
-        uint32_t b = abs32(d[a][0]) + 2 * abs32(d[a][1]) + 3 * abs32(d[a][2]);
+        int32_t* k = c[a];
+        int32_t d = p3[a] - prev_q8_[a];
+        k[0] = arm0[a];
+        k[1] = 3 * d - 2 * arm0[a] - arm3[a];
+        k[2] = arm0[a] + arm3[a] - 2 * d;
+        uint32_t b = abs32(k[0]) + 2 * abs32(k[1]) + 3 * abs32(k[2]);
         if (b > bound) bound = b;
     }
     // N = 2^m > bound (ticks): at most one tick per sample and axis.
     uint8_t m = 0;
     while ((1ul << (m + 8)) <= bound) ++m;
     left_ = static_cast<uint16_t>(1u << m);
+    uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
+    for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
     for (uint8_t a = 0; a < 3; ++a) {
-        base_[a] = p[0][a] >> 8;
         int64_t* v = fd_[a];
-        // Differences at t = 0 for the step 1/N: d1/N + d2/N^2 + d3/N^3, 2 d2/N^2 + 6 d3/N^3,
-        // 6 d3/N^3.
-        int64_t t2 = q40(d[a][1], static_cast<uint8_t>(2 * m)),
-                t3 = q40(d[a][2], static_cast<uint8_t>(3 * m));
-        v[0] = static_cast<int64_t>(p[0][a] & 0xFF) << 32;
-        v[1] = q40(d[a][0], m) + t2 + t3;
-        v[3] = q40(6 * d[a][2], static_cast<uint8_t>(3 * m));
-        v[2] = q40(2 * d[a][1], static_cast<uint8_t>(2 * m)) + v[3];
-        prev_q8_[a] = p[3][a];
+        const int32_t* k = c[a];
+        base_[a] = prev_q8_[a] >> 8;
+        add_q40(v[0], prev_q8_[a] & 0xFF, 0);
+        // Differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3, 2 c2/N^2 + 6 c3/N^3,
+        // 6 c3/N^3.
+        uint8_t s = 0;
+        for (uint8_t i = 0; i < 3; ++i) {
+            s = static_cast<uint8_t>(s + m);
+            add_q40(v[1], k[i], s);
+            if (i != 0) add_q40(v[2], (i == 1 ? 2 : 6) * k[i], s);
+        }
+        add_q40(v[3], 6 * k[2], s);
+        prev_q8_[a] = p3[a];
     }
 }
 
-void CurveWalker::arc_at(int32_t c, int32_t s, int32_t point[2], int32_t arm[2]) const {
-    // X = cu + ru cos t, Y = cv + rv sin t; tangent (-ru sin t, rv cos t) times the arm factor.
+void CurveWalker::arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const {
+    // X = cu + ru cos t, Y = cv + rv sin t; the arm is the tangent (-ru sin t, rv cos t) times
+    // 4 tan(h/4).
     for (uint8_t k = 0; k < 2; ++k) {
         int32_t r = static_cast<int32_t>(a_.radii[k]);
-        point[k] = a_.centre[k] + mul_q30(r, k ? s : c);
-        arm[k] = mul_q30(mul_q30(r, k ? c : -s), a_.arm);
+        point[k] = a_.centre[k] + mul_q30(r, dir[k]);
+        arm[k] = mul_q30(mul_q30(r, k ? dir[0] : -dir[1]), a_.arm);
     }
 }
 
@@ -202,76 +220,72 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
         a_.centre[k] = centre_q8[k];
         a_.radii[k] = radii_q8[k];
     }
-    // Directions of the start and end points (their projections on the curve), and the sweep.
-    ellipse_direction(e.start_q8[0] - a_.centre[0], e.start_q8[1] - a_.centre[1], a_.radii, a_.c,
-                      a_.s);
-    ellipse_direction(e.end_q8[0] - a_.centre[0], e.end_q8[1] - a_.centre[1], a_.radii, end_c_,
-                      end_s_);
-    int64_t sweep = arc_sweep_q29(a_.c, a_.s, end_c_, end_s_, clockwise, turns);
-    // Pieces: at most 3 x 2^26 / 2^29 rad (21.5 degrees) and kMaxPieceTicks long. The sweep is
-    // below 2^40 (255 turns).
-    uint64_t mag = static_cast<uint64_t>(sweep < 0 ? -sweep : sweep);
+    // Directions of the start and end points (their projections on the curve), and the sweep
+    // with the extra turns, radians x 2^20 (below 2^31 for 255 turns).
+    uint32_t mag =
+        (arc_directions(e.start_q8, e.end_q8, a_.centre, a_.radii, clockwise, a_.dir) >> 9) +
+        turns * (kTurnQ29 >> 9);
+    // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees) and kMaxPieceTicks long (sweep x
+    // radius ticks).
     uint32_t rmax = (a_.radii[0] > a_.radii[1] ? a_.radii[0] : a_.radii[1]) >> 8;
-    uint32_t n = static_cast<uint16_t>(mag >> 26) / 3u + 1u;
-    // length = sweep x radius = (mag / 2^29) rmax ticks
-    uint32_t by_length =
-        Num(static_cast<uint32_t>(mag >> 9), -20).mul(rmax + 1).div(kMaxPieceTicks).u32() + 1;
+    uint32_t n = static_cast<uint16_t>(mag >> 17) / 3u + 1u;
+    uint32_t by_length = Num(mag, -20).mul(rmax + 1).div(kMaxPieceTicks).u32() + 1;
     if (by_length > n) n = by_length;
     if (n > 0xFFFF) return false;
     piece_count_ = pieces_ = static_cast<uint16_t>(n);
-    // Piece angle, Q30 (at most 21.5 degrees, so the series apply), and the arm of its cubic:
-    // 4/3 tan(h/4).
-    int32_t h = static_cast<int32_t>(Num(static_cast<uint32_t>(mag >> 10)).div(n).shift(11).u32());
-    if (sweep < 0) h = -h;
-    rotation(h, a_.rot_c, a_.rot_s);
+    // Piece angle h, Q30 (at most 21.5 degrees, so the series apply), and 3 x the arm of its
+    // cubic per unit of radius, 4 tan(h/4).
+    int32_t h = static_cast<int32_t>(Num(mag).div(n).shift(10).u32());
+    if (clockwise) h = -h;
+    rotation(h, a_.rot);
     int32_t x = h / 4;
-    a_.arm = mul_q30(mul_q30(x, series(2, mul_q30(x, x))), 1431655765); // x 4/3
+    a_.arm = 4 * mul_q30(x, series(2, mul_q30(x, x)));
     int32_t p[2], arm[2];
-    arc_at(a_.c, a_.s, p, arm);
+    arc_at(a_.dir[0], p, arm);
     begin(e, p, 1);
     return true;
 }
 
 void CurveWalker::bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const {
-    // B(a) and the arm of the piece starting or ending there, B'(a) / (3 2^j), ticks x 256, by
-    // Horner's rule in 64-bit fixed point.
+    // B(a), and B'(a) / 2^j: 3 x the arm of the piece that starts or ends there (ticks x 256),
+    // by de Casteljau's algorithm: every value stays within the control points' hull.
     for (uint8_t k = 0; k < 2; ++k) {
-        int64_t b = 0, d = 0;
-        for (uint8_t i = 4; i-- > 0;) {
-            b = horner(b, a_q20, poly_[i][k]);
-            if (i) d = horner(d, a_q20, poly_[i][k] * i);
+        int32_t q[4];
+        for (uint8_t i = 0; i < 4; ++i) q[i] = pts_[k][i];
+        for (uint8_t n = 3; n > 1; --n) {
+            for (uint8_t i = 0; i < n; ++i) q[i] = lerp(q[i], q[i + 1], a_q20);
         }
-        point[k] = static_cast<int32_t>(b);
-        arm[k] = third(static_cast<int32_t>(d >> log_pieces_));
+        point[k] = lerp(q[0], q[1], a_q20);
+        // B'(a) = 3 (q1 - q0), with q1 - q0 below 2^31 in magnitude (as the points' differences).
+        int32_t d = static_cast<int32_t>(static_cast<uint32_t>(q[1]) - static_cast<uint32_t>(q[0]));
+        arm[k] = static_cast<int32_t>((static_cast<int64_t>(d) * 3) >> log_pieces_);
     }
 }
 
 bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2_q8[2]) {
     kind_ = 0;
-    uint64_t bound = 0;
+    uint32_t bound = 0; // hodograph bound (power basis), ticks
     for (uint8_t k = 0; k < 2; ++k) {
-        int64_t p0 = e.start_q8[k], p1 = p1_q8[k], p2 = p2_q8[k], p3 = e.end_q8[k];
-        poly_[0][k] = p0;
-        poly_[1][k] = 3 * (p1 - p0);
-        poly_[2][k] = 3 * (p0 - 2 * p1 + p2);
-        poly_[3][k] = p3 - p0 + 3 * (p1 - p2);
-        uint64_t b = 0;
-        for (uint8_t i = 1; i < 4; ++i) {
-            int64_t c = poly_[i][k];
-            b += static_cast<uint64_t>(c < 0 ? -c : c) * i;
-        }
+        int32_t* q = pts_[k];
+        q[0] = e.start_q8[k];
+        q[1] = p1_q8[k];
+        q[2] = p2_q8[k];
+        q[3] = e.end_q8[k];
+        // B'(a) = 3 D1 + 6 D2 a + 3 D3 a^2 (D: the forward differences of the points, ticks).
+        int32_t d[4];
+        for (uint8_t i = 0; i < 4; ++i) d[i] = q[i] >> 8;
+        differences(d);
+        uint32_t b = 3 * (abs32(d[1]) + 2 * abs32(d[2]) + abs32(d[3]));
         if (b > bound) bound = b;
     }
     // 2^j pieces, each with a hodograph bound below kMaxPieceTicks (it shrinks with 2^j).
     uint8_t j = 0;
-    while (((bound >> 8) >> j) >= kMaxPieceTicks) {
+    while ((bound >> j) >= kMaxPieceTicks) {
         if (j == 15) return false;
         ++j;
     }
     log_pieces_ = j;
     piece_count_ = pieces_ = static_cast<uint16_t>(1u << j);
-    end_c_ = e.end_q8[0]; // the last piece lands on the commanded end
-    end_s_ = e.end_q8[1];
     begin(e, e.start_q8, 2);
     return true;
 }
@@ -281,48 +295,38 @@ bool CurveWalker::next_piece() {
     uint16_t index = static_cast<uint16_t>(piece_count_ - pieces_); // 0-based
     --pieces_;
     bool last = pieces_ == 0;
-    int32_t p[4][3]; // control points, ticks x 256
-    for (uint8_t a = 0; a < 3; ++a) p[0][a] = prev_q8_[a];
-    // Helix: w moves linearly, the last piece landing exactly on the end.
+    // The end of the piece on the curve and 3 x its arms at both ends, ticks x 256.
+    int32_t p3[3], arm0[3], arm3[3];
+    // Helix: w moves linearly (arms of a third of its move), the last piece landing exactly on
+    // the end.
     int32_t w3 = dw_q8_;
     if (!last) {
         w3 = static_cast<int32_t>(
             Num(abs32(dw_q8_)).mul(static_cast<uint32_t>(index) + 1).div(piece_count_).u32());
         if (dw_q8_ < 0) w3 = -w3;
     }
-    w3 += w0_q8_;
-    int32_t dw = third(w3 - p[0][2]);
-    p[1][2] = p[0][2] + dw;
-    p[2][2] = w3 - dw;
-    p[3][2] = w3;
-    // The ends of the piece on the curve and the arms of its cubic there.
-    int32_t arm0[2], arm3[2];
+    p3[2] = w3 + w0_q8_;
+    arm0[2] = arm3[2] = p3[2] - prev_q8_[2];
     if (kind_ == 1) {
-        int32_t c = a_.c, s = a_.s;
-        rotate(c, s, a_.rot_c, a_.rot_s);
+        int32_t* dir = a_.dir[0];
+        arc_at(dir, p3, arm0);
+        rotate(dir, a_.rot);
         if (last) { // land on the end point's direction: no drift left over
-            c = end_c_;
-            s = end_s_;
+            dir[0] = a_.dir[1][0];
+            dir[1] = a_.dir[1][1];
         }
-        arc_at(a_.c, a_.s, p[3], arm0); // p[3] is overwritten just below
-        arc_at(c, s, p[3], arm3);
-        a_.c = c;
-        a_.s = s;
+        arc_at(dir, p3, arm3);
     } else {
-        // Bezier part [a, a + 1/n]: ends and tangents of the curve.
+        // Bezier part [a, a + 1/n]: the curve's ends and tangents.
         uint32_t a0 = static_cast<uint32_t>(index) << (20 - log_pieces_);
-        bezier_at(a0, p[3], arm0);
-        bezier_at(a0 + (1ul << (20 - log_pieces_)), p[3], arm3);
-        if (last) {
-            p[3][0] = end_c_;
-            p[3][1] = end_s_;
+        bezier_at(a0, p3, arm0);
+        bezier_at(a0 + (1ul << (20 - log_pieces_)), p3, arm3);
+        if (last) { // the commanded end
+            p3[0] = pts_[0][3];
+            p3[1] = pts_[1][3];
         }
     }
-    for (uint8_t k = 0; k < 2; ++k) {
-        p[1][k] = p[0][k] + arm0[k];
-        p[2][k] = p[3][k] - arm3[k];
-    }
-    start_piece(p);
+    start_piece(p3, arm0, arm3);
     return true;
 }
 
@@ -372,12 +376,21 @@ constexpr uint32_t kNarrowestQ29 = kOneQ29 >> 16;
 // whatever the size of the curve).
 struct Track {
     bool bezier;
-    bool clockwise;  ///< ellipse: the angle decreases
-    int32_t r[2];    ///< ellipse: radii
-    int32_t c, s;    ///< ellipse: direction (cos t, sin t) of the current point, Q30
-    uint32_t t;      ///< Bezier: parameter of the current point, Q29
-    int32_t h[3][2]; ///< Bezier: B'(t) = h0 + t (h1 + t h2)
-    Num ww;          ///< (dw / dparameter)^2: the helix' rise
+    bool clockwise; ///< ellipse: the angle decreases
+    bool w_down;    ///< w decreases along the curve
+    union {
+        struct {
+            int32_t r[2];      ///< radii
+            int32_t dir[2][2]; ///< (cos t, sin t) of the current point and of the end, Q30
+        } e;                   ///< ellipse
+        struct {
+            uint32_t t;      ///< parameter of the current point, Q29
+            int32_t h[3][2]; ///< B'(t) = h0 + t (h1 + t h2)
+        } b;                 ///< Bezier
+    };
+    Num rise; ///< |dw / dparameter|: the helix' rise
+    Num ww;   ///< rise^2 when w counts in the length, else 0
+    Num rmin; ///< Bezier: smallest radius of curvature met so far (0: none)
 };
 
 // Shifts v[0..n-1] left or right so that the largest magnitude is in [2^27, 2^28); the shift.
@@ -404,179 +417,184 @@ int8_t normalise(int32_t* v, uint8_t n) {
 // the current one.
 void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
     if (k.bezier) {
-        uint32_t t = k.t + off;
-        if (move) k.t = t;
+        uint32_t t = k.b.t + off;
+        if (move) k.b.t = t;
         int32_t t30 = static_cast<int32_t>(t << 1);
         for (uint8_t i = 0; i < 2; ++i) {
-            int32_t q = k.h[1][i] + mul_q30(k.h[2][i], t30);
-            d1[i] = k.h[0][i] + mul_q30(q, t30);
-            d2[i] = q + mul_q30(k.h[2][i], t30);
+            int32_t q = k.b.h[1][i] + mul_q30(k.b.h[2][i], t30);
+            d1[i] = k.b.h[0][i] + mul_q30(q, t30);
+            d2[i] = q + mul_q30(k.b.h[2][i], t30);
         }
         return;
     }
-    int32_t c = k.c, s = k.s;
+    int32_t v[2] = {k.e.dir[0][0], k.e.dir[0][1]};
     if (off) {
-        int32_t rc, rs, h = static_cast<int32_t>(off << 1);
-        rotation(k.clockwise ? -h : h, rc, rs);
-        rotate(c, s, rc, rs);
+        int32_t rot[2], h = static_cast<int32_t>(off << 1);
+        rotation(k.clockwise ? -h : h, rot);
+        rotate(v, rot);
     }
     if (move) {
-        k.c = c;
-        k.s = s;
+        k.e.dir[0][0] = v[0];
+        k.e.dir[0][1] = v[1];
     }
-    // (-ru sin t, rv cos t) and (-ru cos t, -rv sin t): only their sizes matter.
-    d1[0] = mul_q30(k.r[0], s);
-    d1[1] = mul_q30(k.r[1], c);
-    d2[0] = mul_q30(k.r[0], c);
-    d2[1] = mul_q30(k.r[1], s);
+    // (-ru sin t, rv cos t), reversed when clockwise, and (-ru cos t, -rv sin t) (only its size
+    // is used).
+    if (k.clockwise) {
+        v[0] = -v[0];
+        v[1] = -v[1];
+    }
+    for (uint8_t i = 0; i < 2; ++i) {
+        d1[i] = mul_q30(k.e.r[i], i ? v[0] : -v[1]);
+        d2[i] = mul_q30(k.e.r[i], v[i]);
+    }
+}
+
+// |(x, y)| with z2 added under the root, for signed x, y.
+Num norm(const int32_t v[2], const Num& z2) {
+    return hypot(Num(abs32(v[0])), Num(abs32(v[1])), z2);
+}
+
+// The speed (x 2^scale) at `off` past the current point: sqrt(|P'|^2 + w'^2).
+Num speed(Track& k, uint32_t off) {
+    int32_t d1[2], d2[2];
+    track_at(k, off, false, d1, d2);
+    return norm(d1, k.ww);
+}
+
+// The unit tangent (P', w') / |(P', w')| at the current point, Q29. Where P' = 0 (a Bezier whose
+// end arm is null), along the next arm: P''(0) or -P''(1), halved to the arm's scale.
+void tangent(Track& k, int32_t out[3]) {
+    int32_t d[2], d2[2];
+    track_at(k, 0, false, d, d2);
+    if (d[0] == 0 && d[1] == 0) {
+        for (uint8_t i = 0; i < 2; ++i) d[i] = k.b.t ? -(d2[i] / 2) : d2[i] / 2;
+    }
+    Num rr = k.rise;
+    Num n = norm(d, rr.mul(k.rise));
+    for (uint8_t i = 0; i < 3; ++i) {
+        Num m = i == 2 ? k.rise : Num(abs32(d[i]));
+        bool negative = i == 2 ? k.w_down : d[i] < 0;
+        out[i] = n.m ? unit_part(m, n, negative, 29) : 0;
+    }
 }
 
 // Length of the track over `span` (Q29) from its current point, x 2^29 x 18 x 2^scale: panels
 // of 3 Gauss-Legendre nodes, each at most half the local scale |P'| / |P''| wide (so that the
 // nearest singularity of |P'| in the complex plane is at least two widths away: 1e-7 relative),
-// and at most `widest`. With `rmin`, the smallest |P'|^3 / |P' x P''| (x 2^scale) over the
-// panel ends is kept there (Beziers).
-Num track_length(Track& k, uint32_t span, uint32_t widest, Num* rmin) {
+// and at most `widest`. For a Bezier, the smallest |P'|^3 / |P' x P''| (x 2^scale) over the
+// panel ends is kept in k.rmin.
+Num track_length(Track& k, uint32_t span, uint32_t widest) {
     Num total{};
     for (;;) {
         int32_t d1[2], d2[2];
         track_at(k, 0, false, d1, d2);
-        Num n1 = hypot(Num(abs32(d1[0])), Num(abs32(d1[1])), Num{});
-        Num n2 = hypot(Num(abs32(d2[0])), Num(abs32(d2[1])), Num{});
-        if (rmin) {
+        Num n1 = norm(d1, Num{});
+        if (k.bezier) {
             int64_t cross =
                 static_cast<int64_t>(d1[0]) * d2[1] - static_cast<int64_t>(d1[1]) * d2[0];
             if (cross != 0 && n1.m != 0) {
+                uint64_t ac = static_cast<uint64_t>(cross < 0 ? -cross : cross);
+                int8_t e = 0;
+                while (ac >> 32) {
+                    ac >>= 1;
+                    ++e;
+                }
                 Num rc = n1;
-                rc.mul(n1).mul(n1).div(num64(static_cast<uint64_t>(cross < 0 ? -cross : cross)));
-                if (rmin->m == 0 || rc.cmp(*rmin) < 0) *rmin = rc;
+                rc.mul(n1).mul(n1).div(Num(static_cast<uint32_t>(ac), e));
+                if (k.rmin.m == 0 || rc.cmp(k.rmin) < 0) k.rmin = rc;
             }
         }
         if (span == 0) return total;
-        uint32_t w = widest;
-        if (n2.m != 0) {
-            uint32_t half = n1.div(n2).shift(28).u32(); // |P'| / |P''| / 2, Q29
-            if (half < w) w = half;
-        }
+        uint32_t w = n1.div(norm(d2, Num{})).shift(28).u32(); // |P'| / |P''| / 2, Q29
+        if (w > widest) w = widest;                           // (also when P'' = 0: 0 / 0)
         if (w < kNarrowestQ29) w = kNarrowestQ29;
         if (w > span) w = span;
         // Nodes at g, w / 2 and w - g, weights 5, 8, 5 (/ 18).
         const uint32_t g = static_cast<uint32_t>(mul_q30(static_cast<int32_t>(w), kGaussQ30));
-        const uint32_t at[3] = {g, w / 2, w - g};
-        Num f[3];
-        for (uint8_t i = 0; i < 3; ++i) {
-            track_at(k, at[i], false, d1, d2);
-            f[i] = hypot(Num(abs32(d1[0])), Num(abs32(d1[1])), k.ww);
-        }
-        total.add(f[0].add(f[2]).mul(5).add(f[1].mul(8)).mul(w));
+        Num sum = speed(k, g);
+        Num mid = speed(k, w / 2);
+        total.add(sum.add(speed(k, w - g)).mul(5).add(mid.mul(8)).mul(w));
         track_at(k, w, true, d1, d2);
         span -= w;
     }
 }
 
+// The rise (|dw| per unit of parameter, µm) scaled as the track.
+void set_rise(Track& k, Num rise, int8_t scale, int32_t dw_um, bool w_regulated) {
+    k.rise = rise.shift(scale);
+    k.w_down = dw_um < 0;
+    if (w_regulated) {
+        k.ww = k.rise;
+        k.ww.mul(k.rise);
+    }
+}
+
+// Length of an arc (circle or ellipse, helical when w moves), its smallest radius of curvature
+// and its end tangents.
+__attribute__((noinline)) Num arc_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated,
+                                        Track& k, CurveShape& out) {
+    const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
+    if (r[0] == 0 || r[1] == 0) return Num{};
+    k.clockwise = cp.clockwise != 0;
+    // The sweep in (0, 2 pi], and with the extra full turns, radians.
+    const uint32_t part = arc_directions(cp.start_um, cp.end_um, cp.a_um, r, k.clockwise, k.e.dir);
+    Num angle = Num(kTurnQ29, -29).mul(cp.turns).add(Num(part, -29));
+    k.e.r[0] = static_cast<int32_t>(r[0]);
+    k.e.r[1] = static_cast<int32_t>(r[1]);
+    const int8_t scale = normalise(k.e.r, 2);
+    // w rises linearly with the angle: dw / |sweep| per radian.
+    set_rise(k, Num(abs32(dw_um)).div(angle), scale, dw_um, w_regulated);
+    tangent(k, out.start_dir);
+    const uint32_t lo = r[0] < r[1] ? r[0] : r[1], hi = r[0] + r[1] - lo;
+    out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
+    Num len = angle.mul(r[0]);                         // a circle: r |sweep| ...
+    if (lo != hi) {
+        // ... an ellipse: the partial turn, then a full turn (from wherever) for the extra ones.
+        len = track_length(k, part, kWidestArcQ29);
+        if (cp.turns) len.add(track_length(k, kTurnQ29, kWidestArcQ29).mul(cp.turns));
+        len.div(18).shift(static_cast<int8_t>(-29 - scale));
+    } else if (w_regulated) { // a circular helix: sqrt(plane^2 + dw^2)
+        len = hypot(len, Num(abs32(dw_um)), Num{});
+    }
+    k.e.dir[0][0] = k.e.dir[1][0];
+    k.e.dir[0][1] = k.e.dir[1][1];
+    tangent(k, out.end_dir);
+    return len;
+}
+
+// Length of a Bezier (helical when w moves: by dw per unit of t), its smallest radius of
+// curvature and its end tangents.
+__attribute__((noinline)) Num bezier_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated,
+                                           Track& k, CurveShape& out) {
+    // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
+    // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so these
+    // fit.
+    const int32_t* p[4] = {cp.start_um, cp.a_um, cp.b_um, cp.end_um};
+    for (uint8_t i = 0; i < 2; ++i) {
+        int32_t q[4];
+        for (uint8_t j = 0; j < 4; ++j) q[j] = p[j][i];
+        differences(q);
+        k.b.h[0][i] = 3 * q[1];
+        k.b.h[1][i] = 6 * q[2];
+        k.b.h[2][i] = 3 * q[3];
+    }
+    const int8_t scale = normalise(&k.b.h[0][0], 6);
+    k.bezier = true;
+    set_rise(k, Num(abs32(dw_um)), scale, dw_um, w_regulated);
+    tangent(k, out.start_dir);
+    Num len = track_length(k, kOneQ29, kWidestBezierQ29);
+    tangent(k, out.end_dir);
+    out.min_radius_um = k.rmin.m ? k.rmin.shift(static_cast<int8_t>(-scale)).u32() : 0xFFFFFFFFul;
+    return len.div(18).shift(static_cast<int8_t>(-29 - scale));
+}
+
 } // namespace
 
 bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
-    const int32_t dw = w_regulated ? dw_um : 0;
     Track k{};
-    Num len{};
-    Num tangent[2][3];   // unit tangents at both ends: magnitudes, ...
-    uint8_t negative[2]; // ... and sign bits (1 = u, 2 = v, 4 = w)
-    if (cp.kind == kCurveArc) {
-        const uint32_t r[2] = {static_cast<uint32_t>(cp.b_um[0]),
-                               static_cast<uint32_t>(cp.b_um[1])};
-        if (r[0] == 0 || r[1] == 0) return false;
-        int32_t c0, s0, c1, s1;
-        ellipse_direction(cp.start_um[0] - cp.a_um[0], cp.start_um[1] - cp.a_um[1], r, c0, s0);
-        ellipse_direction(cp.end_um[0] - cp.a_um[0], cp.end_um[1] - cp.a_um[1], r, c1, s1);
-        const bool cw = cp.clockwise != 0;
-        // The sweep in (0, 2 pi], plus the extra full turns: radians.
-        int64_t sweep = arc_sweep_q29(c0, s0, c1, s1, cw, 0);
-        const uint32_t part = static_cast<uint32_t>(sweep < 0 ? -sweep : sweep);
-        constexpr uint32_t kTurnQ29 = 2ul * kPiQ29;
-        Num angle = Num(kTurnQ29, -29).mul(cp.turns).add(Num(part, -29));
-        // w rises linearly with the angle: dw / |sweep| per radian.
-        Num rise = Num(abs32(dw_um)).div(angle);
-        uint32_t lo = r[0] < r[1] ? r[0] : r[1], hi = r[0] < r[1] ? r[1] : r[0];
-        if (r[0] == r[1]) {
-            len = angle;
-            len.mul(r[0]); // r |sweep|
-            out.min_radius_um = r[0];
-        } else {
-            k.r[0] = static_cast<int32_t>(r[0]);
-            k.r[1] = static_cast<int32_t>(r[1]);
-            const int8_t scale = normalise(k.r, 2);
-            k.c = c0;
-            k.s = s0;
-            k.clockwise = cw;
-            if (dw != 0) {
-                k.ww = Num(abs32(dw)).div(angle).shift(scale);
-                k.ww.mul(k.ww);
-            }
-            len = track_length(k, part, kWidestArcQ29, nullptr);
-            if (cp.turns) {
-                k.c = c0;
-                k.s = s0;
-                len.add(track_length(k, kTurnQ29, kWidestArcQ29, nullptr).mul(cp.turns));
-            }
-            len.div(18).shift(static_cast<int8_t>(-29 - scale));
-            out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // a^2 / b at the flat ends
-        }
-        // Tangents: (-ru sin t, rv cos t, rise), reversed when clockwise.
-        const int32_t cs[2][2] = {{c0, s0}, {c1, s1}};
-        for (uint8_t e = 0; e < 2; ++e) {
-            const int32_t c = cs[e][0], s = cs[e][1];
-            tangent[e][0] = Num(r[0]).mul(abs32(s)).shift(-30);
-            tangent[e][1] = Num(r[1]).mul(abs32(c)).shift(-30);
-            tangent[e][2] = rise;
-            negative[e] = static_cast<uint8_t>(((s > 0) != cw ? 1 : 0) | ((c < 0) != cw ? 2 : 0) |
-                                               (dw_um < 0 ? 4 : 0));
-        }
-        if (r[0] == r[1] && dw != 0) { // circular helix: sqrt(plane^2 + dw^2)
-            Num w(abs32(dw));
-            Num l2 = len;
-            len = l2.mul(len).add(w.mul(w)).sqrt();
-        }
-    } else {
-        // Hodograph B'(t) = a (1-t)^2 + 2 b (1-t) t + c t^2 with a, b, c three times the arms,
-        // as h0 + t (h1 + t h2). The G-code checks (error:33) keep the control polygon below
-        // 2^23 µm, so these fit.
-        const int32_t p[4][2] = {{cp.start_um[0], cp.start_um[1]},
-                                 {cp.a_um[0], cp.a_um[1]},
-                                 {cp.b_um[0], cp.b_um[1]},
-                                 {cp.end_um[0], cp.end_um[1]}};
-        for (uint8_t i = 0; i < 2; ++i) {
-            k.h[0][i] = 3 * (p[1][i] - p[0][i]);
-            k.h[1][i] = 6 * (p[2][i] - 2 * p[1][i] + p[0][i]);
-            k.h[2][i] = 3 * (p[3][i] - p[0][i]) + 9 * (p[1][i] - p[2][i]);
-        }
-        const int8_t scale = normalise(&k.h[0][0], 6);
-        k.bezier = true;
-        if (dw != 0) {
-            k.ww = Num(abs32(dw)).shift(scale);
-            k.ww.mul(k.ww);
-        }
-        Num rmin{};
-        len = track_length(k, kOneQ29, kWidestBezierQ29, &rmin);
-        len.div(18).shift(static_cast<int8_t>(-29 - scale));
-        out.min_radius_um = rmin.m ? rmin.shift(static_cast<int8_t>(-scale)).u32() : 0xFFFFFFFFul;
-        // Tangents: the first non-degenerate arm at each end, 3 arms per unit of t as B' is;
-        // w rises by dw per unit of t.
-        const int32_t ends[2][2][2] = {
-            {{p[1][0] - p[0][0], p[1][1] - p[0][1]}, {p[2][0] - p[0][0], p[2][1] - p[0][1]}},
-            {{p[3][0] - p[2][0], p[3][1] - p[2][1]}, {p[3][0] - p[1][0], p[3][1] - p[1][1]}}};
-        for (uint8_t e = 0; e < 2; ++e) {
-            const int32_t* arm = ends[e][0];
-            if (arm[0] == 0 && arm[1] == 0) arm = ends[e][1];
-            tangent[e][0] = Num(abs32(arm[0])).mul(3);
-            tangent[e][1] = Num(abs32(arm[1])).mul(3);
-            tangent[e][2] = Num(abs32(dw_um));
-            negative[e] = static_cast<uint8_t>((arm[0] < 0 ? 1 : 0) | (arm[1] < 0 ? 2 : 0) |
-                                               (dw_um < 0 ? 4 : 0));
-        }
-    }
-    unit3(tangent[0], negative[0], out.start_dir);
-    unit3(tangent[1], negative[1], out.end_dir);
+    if (dw_um == 0) w_regulated = false;
+    Num len = cp.kind == kCurveArc ? arc_shape(cp, dw_um, w_regulated, k, out)
+                                   : bezier_shape(cp, dw_um, w_regulated, k, out);
     if (len.m == 0) return false;
     out.len_q8 = len.shift(8).u32();
     return true;

@@ -112,8 +112,8 @@ class CurveWalker {
   private:
     void begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind);
     bool next_piece();
-    void start_piece(const int32_t p[4][3]);
-    void arc_at(int32_t c, int32_t s, int32_t point[2], int32_t arm[2]) const;
+    void start_piece(const int32_t p3[3], const int32_t arm0[3], const int32_t arm3[3]);
+    void arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const;
     void bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const;
 
     // Current piece, per axis: the position and its forward differences (f, d1, d2, d3), Q40
@@ -129,18 +129,18 @@ class CurveWalker {
     int32_t end_[3];        ///< final position, ticks
     int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
     int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
-    int32_t end_c_, end_s_; ///< arc: direction of the end point; Bezier: the end (ticks x 256)
     uint8_t log_pieces_;    ///< Bezier: 2^j pieces
     // An arc or a Bezier, never both.
     struct ArcState {
         int32_t centre[2];
         uint32_t radii[2];
-        int32_t c, s, rot_c, rot_s, arm; ///< unit vector of the next piece's start, rotation
-                                         ///< per piece and arm length, Q30
+        int32_t dir[2][2]; ///< (cos t, sin t) of the next piece's start and of the end, Q30
+        int32_t rot[2];    ///< cosine and sine of the piece angle h, Q30
+        int32_t arm;       ///< 4 tan(h/4): 3 x a piece's arm per unit of radius, Q30
     };
     union {
         ArcState a_;
-        int64_t poly_[4][2]; ///< Bezier: B(a) = c0 + c1 a + c2 a^2 + c3 a^3, ticks x 256
+        int32_t pts_[2][4]; ///< Bezier: control points, u then v, ticks x 256
     };
 };
 
