@@ -3,6 +3,10 @@
 #include "lowlevel/fixmath.h"
 #include "lowlevel/pgm.h"
 
+#include <string.h>
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the walker reads the high word of int64");
+
 // Size on the ATmega328P: every 64-bit addition, shift or product is a library call wrapped in
 // long register moves, and every Num operation a call sequence. So these operations are written
 // once, in the out-of-line helpers below, and the axes are loops, not copies.
@@ -100,16 +104,8 @@ uint32_t arc_directions(const int32_t start[2], const int32_t end[2], const int3
     return sweep_q29(a[0], a[1], clockwise);
 }
 
-// Sets `pos` to p, with the bit of the axis in `moved` (and in `neg` when it goes down).
-void move_to(int32_t& pos, int32_t p, uint8_t bit, uint8_t& moved, uint8_t& neg) {
-    if (p == pos) return;
-    moved = static_cast<uint8_t>(moved | bit);
-    if (p < pos) neg = static_cast<uint8_t>(neg | bit);
-    pos = p;
-}
-
 // One sample of a cubic by forward differencing: f += d1, d1 += d2, d2 += d3 (v = f, d1, d2, d3).
-__attribute__((noinline)) void fd_step(int64_t v[4]) {
+inline void fd_step(int64_t v[4]) {
     v[0] += v[1];
     v[1] += v[2];
     v[2] += v[3];
@@ -143,9 +139,8 @@ void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], i
 
 int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clockwise,
                       uint8_t turns) {
-    int64_t sweep =
-        static_cast<int64_t>(sweep_q29(atan2_q29(s0, c0), atan2_q29(s1, c1), clockwise) +
-                             static_cast<uint64_t>(turns) * kTurnQ29);
+    int64_t sweep = sweep_q29(atan2_q29(s0, c0), atan2_q29(s1, c1), clockwise);
+    while (turns--) sweep += kTurnQ29;
     return clockwise ? -sweep : sweep;
 }
 
@@ -238,7 +233,7 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     int32_t h = static_cast<int32_t>(Num(mag).div(n).shift(10).u32());
     if (clockwise) h = -h;
     rotation(h, a_.rot);
-    int32_t x = h / 4;
+    int32_t x = h >> 2;
     a_.arm = 4 * mul_q30(x, series(2, mul_q30(x, x)));
     int32_t p[2], arm[2];
     arc_at(a_.dir[0], p, arm);
@@ -338,20 +333,30 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
             // Last step: from the rounded end of the curve to the exact target (at most one
             // tick per axis: both are within 0.71 tick of the curve's end point).
             kind_ = 0;
-            for (uint8_t a = 0; a < 3; ++a) {
-                move_to(pos[a], end_[a], static_cast<uint8_t>(1u << a), moved, neg);
-            }
-            return moved != 0;
+            break;
         }
     }
-    --left_;
-    for (uint8_t a = 0; a < axes_; ++a) {
-        int64_t* v = fd_[a];
-        fd_step(v);
-        // round(f / 2^40) from the high word: floor((hi + 2^7) / 2^8)
-        int32_t hi = static_cast<int32_t>(v[0] >> 32);
-        move_to(pos[a], base_[a] + ((hi + 128) >> 8), static_cast<uint8_t>(1u << a), moved, neg);
+    for (uint8_t a = 0; a < 3; ++a) {
+        int32_t p = end_[a];
+        if (kind_ != 0) {
+            if (a == axes_) break;
+            int64_t* v = fd_[a];
+            fd_step(v);
+            // round(f / 2^40) from the high word: floor((hi + 2^7) / 2^8). The word is read
+            // from memory: avr-gcc would shift the 64 bits through a library loop.
+            int32_t hi;
+            memcpy(&hi, reinterpret_cast<const uint8_t*>(v) + 4, 4);
+            p = base_[a] + ((hi + 128) >> 8);
+        }
+        if (p != pos[a]) {
+            const uint8_t bit = static_cast<uint8_t>(1u << a);
+            moved = static_cast<uint8_t>(moved | bit);
+            if (p < pos[a]) neg = static_cast<uint8_t>(neg | bit);
+            pos[a] = p;
+        }
     }
+    if (kind_ == 0) return moved != 0;
+    --left_;
     return true;
 }
 
@@ -467,7 +472,7 @@ void tangent(Track& k, int32_t out[3]) {
     int32_t d[2], d2[2];
     track_at(k, 0, false, d, d2);
     if (d[0] == 0 && d[1] == 0) {
-        for (uint8_t i = 0; i < 2; ++i) d[i] = k.b.t ? -(d2[i] / 2) : d2[i] / 2;
+        for (uint8_t i = 0; i < 2; ++i) d[i] = k.b.t ? -(d2[i] >> 1) : d2[i] >> 1;
     }
     Num rr = k.rise;
     Num n = norm(d, rr.mul(k.rise));
@@ -490,17 +495,12 @@ Num track_length(Track& k, uint32_t span, uint32_t widest) {
         track_at(k, 0, false, d1, d2);
         Num n1 = norm(d1, Num{});
         if (k.bezier) {
-            int64_t cross =
-                static_cast<int64_t>(d1[0]) * d2[1] - static_cast<int64_t>(d1[1]) * d2[0];
-            if (cross != 0 && n1.m != 0) {
-                uint64_t ac = static_cast<uint64_t>(cross < 0 ? -cross : cross);
-                int8_t e = 0;
-                while (ac >> 32) {
-                    ac >>= 1;
-                    ++e;
-                }
+            // |P' x P''| / 2^30: both are below 2^30, and where the radius is smallest this
+            // keeps 20 bits.
+            int32_t cross = mul_q30(d1[0], d2[1]) - mul_q30(d1[1], d2[0]);
+            if (cross != 0) {
                 Num rc = n1;
-                rc.mul(n1).mul(n1).div(Num(static_cast<uint32_t>(ac), e));
+                rc.mul(n1).mul(n1).div(abs32(cross)).shift(-30);
                 if (k.rmin.m == 0 || rc.cmp(k.rmin) < 0) k.rmin = rc;
             }
         }
@@ -519,82 +519,71 @@ Num track_length(Track& k, uint32_t span, uint32_t widest) {
     }
 }
 
-// The rise (|dw| per unit of parameter, µm) scaled as the track.
-void set_rise(Track& k, Num rise, int8_t scale, int32_t dw_um, bool w_regulated) {
-    k.rise = rise.shift(scale);
-    k.w_down = dw_um < 0;
-    if (w_regulated) {
-        k.ww = k.rise;
-        k.ww.mul(k.rise);
-    }
-}
-
-// Length of an arc (circle or ellipse, helical when w moves), its smallest radius of curvature
-// and its end tangents.
-__attribute__((noinline)) Num arc_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated,
-                                        Track& k, CurveShape& out) {
-    const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
-    if (r[0] == 0 || r[1] == 0) return Num{};
-    k.clockwise = cp.clockwise != 0;
-    // The sweep in (0, 2 pi], and with the extra full turns, radians.
-    const uint32_t part = arc_directions(cp.start_um, cp.end_um, cp.a_um, r, k.clockwise, k.e.dir);
-    Num angle = Num(kTurnQ29, -29).mul(cp.turns).add(Num(part, -29));
-    k.e.r[0] = static_cast<int32_t>(r[0]);
-    k.e.r[1] = static_cast<int32_t>(r[1]);
-    const int8_t scale = normalise(k.e.r, 2);
-    // w rises linearly with the angle: dw / |sweep| per radian.
-    set_rise(k, Num(abs32(dw_um)).div(angle), scale, dw_um, w_regulated);
-    tangent(k, out.start_dir);
-    const uint32_t lo = r[0] < r[1] ? r[0] : r[1], hi = r[0] + r[1] - lo;
-    out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
-    Num len = angle.mul(r[0]);                         // a circle: r |sweep| ...
-    if (lo != hi) {
-        // ... an ellipse: the partial turn, then a full turn (from wherever) for the extra ones.
-        len = track_length(k, part, kWidestArcQ29);
-        if (cp.turns) len.add(track_length(k, kTurnQ29, kWidestArcQ29).mul(cp.turns));
-        len.div(18).shift(static_cast<int8_t>(-29 - scale));
-    } else if (w_regulated) { // a circular helix: sqrt(plane^2 + dw^2)
-        len = hypot(len, Num(abs32(dw_um)), Num{});
-    }
-    k.e.dir[0][0] = k.e.dir[1][0];
-    k.e.dir[0][1] = k.e.dir[1][1];
-    tangent(k, out.end_dir);
-    return len;
-}
-
-// Length of a Bezier (helical when w moves: by dw per unit of t), its smallest radius of
-// curvature and its end tangents.
-__attribute__((noinline)) Num bezier_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated,
-                                           Track& k, CurveShape& out) {
-    // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
-    // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so these
-    // fit.
-    const int32_t* p[4] = {cp.start_um, cp.a_um, cp.b_um, cp.end_um};
-    for (uint8_t i = 0; i < 2; ++i) {
-        int32_t q[4];
-        for (uint8_t j = 0; j < 4; ++j) q[j] = p[j][i];
-        differences(q);
-        k.b.h[0][i] = 3 * q[1];
-        k.b.h[1][i] = 6 * q[2];
-        k.b.h[2][i] = 3 * q[3];
-    }
-    const int8_t scale = normalise(&k.b.h[0][0], 6);
-    k.bezier = true;
-    set_rise(k, Num(abs32(dw_um)), scale, dw_um, w_regulated);
-    tangent(k, out.start_dir);
-    Num len = track_length(k, kOneQ29, kWidestBezierQ29);
-    tangent(k, out.end_dir);
-    out.min_radius_um = k.rmin.m ? k.rmin.shift(static_cast<int8_t>(-scale)).u32() : 0xFFFFFFFFul;
-    return len.div(18).shift(static_cast<int8_t>(-29 - scale));
-}
-
 } // namespace
 
 bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
     Track k{};
-    if (dw_um == 0) w_regulated = false;
-    Num len = cp.kind == kCurveArc ? arc_shape(cp, dw_um, w_regulated, k, out)
-                                   : bezier_shape(cp, dw_um, w_regulated, k, out);
+    k.w_down = dw_um < 0;
+    int8_t scale;
+    uint32_t span = kOneQ29, widest = kWidestBezierQ29, lo = 0, hi = 1;
+    uint8_t turns = 0;
+    Num len{};
+    if (cp.kind == kCurveArc) {
+        const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
+        if (r[0] == 0 || r[1] == 0) return false;
+        k.clockwise = cp.clockwise != 0;
+        // The sweep in (0, 2 pi], and with the extra full turns, radians.
+        span = arc_directions(cp.start_um, cp.end_um, cp.a_um, r, k.clockwise, k.e.dir);
+        widest = kWidestArcQ29;
+        turns = cp.turns;
+        len = Num(kTurnQ29, -29).mul(turns).add(Num(span, -29));
+        // w rises linearly with the angle: dw / |sweep| per radian.
+        k.rise = Num(abs32(dw_um)).div(len);
+        k.e.r[0] = static_cast<int32_t>(r[0]);
+        k.e.r[1] = static_cast<int32_t>(r[1]);
+        scale = normalise(k.e.r, 2);
+        lo = r[0] < r[1] ? r[0] : r[1];
+        hi = r[0] + r[1] - lo;
+        out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
+        len.mul(r[0]);                                     // a circle: r |sweep|
+        if (dw_um != 0 && w_regulated) len = hypot(len, Num(abs32(dw_um)), Num{}); // and a helix
+    } else {
+        // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
+        // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
+        // these fit. w rises by dw per unit of t.
+        const int32_t* p[4] = {cp.start_um, cp.a_um, cp.b_um, cp.end_um};
+        for (uint8_t i = 0; i < 2; ++i) {
+            int32_t q[4];
+            for (uint8_t j = 0; j < 4; ++j) q[j] = p[j][i];
+            differences(q);
+            k.b.h[0][i] = 3 * q[1];
+            k.b.h[1][i] = 6 * q[2];
+            k.b.h[2][i] = 3 * q[3];
+        }
+        scale = normalise(&k.b.h[0][0], 6);
+        k.bezier = true;
+        k.rise = Num(abs32(dw_um));
+    }
+    k.rise.shift(scale);
+    if (w_regulated) {
+        k.ww = k.rise;
+        k.ww.mul(k.rise);
+    }
+    tangent(k, out.start_dir);
+    if (lo != hi) { // not a circle: ellipses and Beziers by quadrature
+        len = track_length(k, span, widest);
+        // An ellipse's extra turns: a full turn from wherever.
+        if (turns) len.add(track_length(k, kTurnQ29, widest).mul(turns));
+        len.div(18).shift(static_cast<int8_t>(-29 - scale));
+    }
+    if (k.bezier) {
+        out.min_radius_um =
+            k.rmin.m ? k.rmin.shift(static_cast<int8_t>(-scale)).u32() : 0xFFFFFFFFul;
+    } else {
+        k.e.dir[0][0] = k.e.dir[1][0];
+        k.e.dir[0][1] = k.e.dir[1][1];
+    }
+    tangent(k, out.end_dir);
     if (len.m == 0) return false;
     out.len_q8 = len.shift(8).u32();
     return true;
