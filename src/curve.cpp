@@ -362,7 +362,9 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
 
 uint16_t CurveWalker::peek(int32_t d[3]) {
     while (left_ == 0 && kind_ != 0 && pieces_ != 0) next_piece();
-    for (uint8_t a = 0; a < 3; ++a) d[a] = static_cast<int32_t>(fd_[a][1] >> 24);
+    // d1 / 2^24 (below 2^17): bits 24 to 55 of the little-endian word.
+    for (uint8_t a = 0; a < 3; ++a)
+        memcpy(&d[a], reinterpret_cast<const uint8_t*>(&fd_[a][1]) + 3, 4);
     return left_;
 }
 
@@ -414,7 +416,9 @@ int8_t normalise(int32_t* v, uint8_t n) {
         big <<= 1;
         ++sh;
     }
-    for (uint8_t i = 0; i < n; ++i) v[i] = sh < 0 ? v[i] >> -sh : v[i] * (1l << sh);
+    for (uint8_t i = 0; i < n; ++i) {
+        v[i] = sh < 0 ? v[i] >> -sh : static_cast<int32_t>(static_cast<uint32_t>(v[i]) << sh);
+    }
     return sh;
 }
 
@@ -459,74 +463,80 @@ Num norm(const int32_t v[2], const Num& z2) {
     return hypot(Num(abs32(v[0])), Num(abs32(v[1])), z2);
 }
 
-// The speed (x 2^scale) at `off` past the current point: sqrt(|P'|^2 + w'^2).
-Num speed(Track& k, uint32_t off) {
-    int32_t d1[2], d2[2];
-    track_at(k, off, false, d1, d2);
-    return norm(d1, k.ww);
-}
-
 // The unit tangent (P', w') / |(P', w')| at the current point, Q29. Where P' = 0 (a Bezier whose
 // end arm is null), along the next arm: P''(0) or -P''(1), halved to the arm's scale.
 void tangent(Track& k, int32_t out[3]) {
     int32_t d[2], d2[2];
     track_at(k, 0, false, d, d2);
     if (d[0] == 0 && d[1] == 0) {
-        for (uint8_t i = 0; i < 2; ++i) d[i] = k.b.t ? -(d2[i] >> 1) : d2[i] >> 1;
+        for (uint8_t i = 0; i < 2; ++i) {
+            d[i] = d2[i] >> 1;
+            if (k.b.t) d[i] = -d[i];
+        }
     }
-    Num rr = k.rise;
-    Num n = norm(d, rr.mul(k.rise));
-    for (uint8_t i = 0; i < 3; ++i) {
-        Num m = i == 2 ? k.rise : Num(abs32(d[i]));
-        bool negative = i == 2 ? k.w_down : d[i] < 0;
-        out[i] = n.m ? unit_part(m, n, negative, 29) : 0;
+    Num x(abs32(d[0])), y(abs32(d[1])), rr = k.rise;
+    Num n = hypot(x, y, rr.mul(k.rise));
+    if (n.m == 0) return; // out stays 0
+    out[0] = unit_part(x, n, d[0] < 0, 29);
+    out[1] = unit_part(y, n, d[1] < 0, 29);
+    out[2] = unit_part(k.rise, n, k.w_down, 29);
+}
+
+// The track at `off` (Q29) past its current point, which with `move` becomes the current one:
+// returns the speed sqrt(|P'|^2 + w'^2) (x 2^scale) and, with `half`, |P'| / |P''| / 2 (Q29: the
+// widest panel there). On a Bezier, the radius of curvature |P'|^3 / |P' x P''| (x 2^scale) there
+// is kept in k.rmin when it is the smallest so far.
+Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
+    int32_t d1[2], d2[2];
+    track_at(k, off, move, d1, d2);
+    Num n1 = norm(d1, Num{});
+    if (k.bezier) {
+        // |P' x P''| / 2^30: both are below 2^30, and where the radius is smallest this keeps 20
+        // bits.
+        int32_t cross = mul_q30(d1[0], d2[1]) - mul_q30(d1[1], d2[0]);
+        if (cross != 0) {
+            Num rc = n1;
+            rc.mul(n1).mul(n1).div(abs32(cross)).shift(-30);
+            if (k.rmin.m == 0 || rc.cmp(k.rmin) < 0) k.rmin = rc;
+        }
     }
+    if (half) *half = Num(n1).div(norm(d2, Num{})).shift(28).u32(); // 0 / 0 when P'' = 0
+    return k.ww.m ? norm(d1, k.ww) : n1;
 }
 
 // Length of the track over `span` (Q29) from its current point, x 2^29 x 18 x 2^scale: panels
 // of 3 Gauss-Legendre nodes, each at most half the local scale |P'| / |P''| wide (so that the
 // nearest singularity of |P'| in the complex plane is at least two widths away: 1e-7 relative),
-// and at most `widest`. For a Bezier, the smallest |P'|^3 / |P' x P''| (x 2^scale) over the
-// panel ends is kept in k.rmin.
+// and at most `widest`. On a Bezier, the radii of curvature are sampled at every node and panel
+// end, and these crowd where the curve turns tightly.
 Num track_length(Track& k, uint32_t span, uint32_t widest) {
     Num total{};
-    for (;;) {
-        int32_t d1[2], d2[2];
-        track_at(k, 0, false, d1, d2);
-        Num n1 = norm(d1, Num{});
-        if (k.bezier) {
-            // |P' x P''| / 2^30: both are below 2^30, and where the radius is smallest this
-            // keeps 20 bits.
-            int32_t cross = mul_q30(d1[0], d2[1]) - mul_q30(d1[1], d2[0]);
-            if (cross != 0) {
-                Num rc = n1;
-                rc.mul(n1).mul(n1).div(abs32(cross)).shift(-30);
-                if (k.rmin.m == 0 || rc.cmp(k.rmin) < 0) k.rmin = rc;
-            }
-        }
-        if (span == 0) return total;
-        uint32_t w = n1.div(norm(d2, Num{})).shift(28).u32(); // |P'| / |P''| / 2, Q29
-        if (w > widest) w = widest;                           // (also when P'' = 0: 0 / 0)
+    uint32_t w;
+    probe(k, 0, false, &w);
+    while (span != 0) {
+        if (w == 0 || w > widest) w = widest;
         if (w < kNarrowestQ29) w = kNarrowestQ29;
         if (w > span) w = span;
         // Nodes at g, w / 2 and w - g, weights 5, 8, 5 (/ 18).
         const uint32_t g = static_cast<uint32_t>(mul_q30(static_cast<int32_t>(w), kGaussQ30));
-        Num sum = speed(k, g);
-        Num mid = speed(k, w / 2);
-        total.add(sum.add(speed(k, w - g)).mul(5).add(mid.mul(8)).mul(w));
-        track_at(k, w, true, d1, d2);
+        Num sum = probe(k, g, false, nullptr);
+        sum.add(probe(k, w - g, false, nullptr)).mul(5).add(probe(k, w / 2, false, nullptr).mul(8));
+        total.add(sum.mul(w));
         span -= w;
+        probe(k, w, true, &w);
     }
+    return total;
 }
 
-} // namespace
-
-bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
-    Track k{};
+// curve_shape() with its track passed in: the track is then reached through a pointer, not
+// through a stack frame too large for the AVR's displacement addressing.
+__attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated,
+                                     CurveShape& out, Track& k) {
     k.w_down = dw_um < 0;
     int8_t scale;
-    uint32_t span = kOneQ29, widest = kWidestBezierQ29, lo = 0, hi = 1;
+    uint32_t span = kOneQ29, widest = kWidestBezierQ29;
     uint8_t turns = 0;
+    bool circle = false;
     Num len{};
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
@@ -542,11 +552,12 @@ bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveSh
         k.e.r[0] = static_cast<int32_t>(r[0]);
         k.e.r[1] = static_cast<int32_t>(r[1]);
         scale = normalise(k.e.r, 2);
-        lo = r[0] < r[1] ? r[0] : r[1];
-        hi = r[0] + r[1] - lo;
+        const uint32_t lo = r[0] < r[1] ? r[0] : r[1];
+        const uint32_t hi = r[0] ^ r[1] ^ lo;
         out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
-        len.mul(r[0]);                                     // a circle: r |sweep|
-        if (dw_um != 0 && w_regulated) len = hypot(len, Num(abs32(dw_um)), Num{}); // and a helix
+        circle = lo == hi;
+        len.mul(lo); // a circle: r |sweep|, and a helix: sqrt(plane^2 + dw^2)
+        if (w_regulated) len = hypot(len, Num(abs32(dw_um)), Num{});
     } else {
         // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
@@ -556,9 +567,7 @@ bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveSh
             int32_t q[4];
             for (uint8_t j = 0; j < 4; ++j) q[j] = p[j][i];
             differences(q);
-            k.b.h[0][i] = 3 * q[1];
-            k.b.h[1][i] = 6 * q[2];
-            k.b.h[2][i] = 3 * q[3];
+            for (uint8_t j = 0; j < 3; ++j) k.b.h[j][i] = (j == 1 ? 6 : 3) * q[j + 1];
         }
         scale = normalise(&k.b.h[0][0], 6);
         k.bezier = true;
@@ -570,7 +579,7 @@ bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveSh
         k.ww.mul(k.rise);
     }
     tangent(k, out.start_dir);
-    if (lo != hi) { // not a circle: ellipses and Beziers by quadrature
+    if (!circle) { // ellipses and Beziers by quadrature
         len = track_length(k, span, widest);
         // An ellipse's extra turns: a full turn from wherever.
         if (turns) len.add(track_length(k, kTurnQ29, widest).mul(turns));
@@ -587,6 +596,15 @@ bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveSh
     if (len.m == 0) return false;
     out.len_q8 = len.shift(8).u32();
     return true;
+}
+
+} // namespace
+
+bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
+    Track k{};
+    out.start_dir[0] = out.start_dir[1] = out.start_dir[2] = 0;
+    out.end_dir[0] = out.end_dir[1] = out.end_dir[2] = 0;
+    return shape(cp, dw_um, w_regulated && dw_um != 0, out, k);
 }
 
 } // namespace ll
