@@ -111,9 +111,10 @@ inline void fd_step(int64_t v[4]) {
     v[2] += v[3];
 }
 
-// acc += x / 2^s in Q40 for x in Q8 (s <= 36): exact for s <= 32, floored beyond.
-__attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s) {
-    acc += (static_cast<int64_t>(x) << 32) >> s;
+// acc += n x / 2^s in Q40 for x in Q8 (n x below 2^31, s <= 36): exact for s <= 32, floored
+// beyond.
+__attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s, uint8_t n) {
+    acc += (static_cast<int64_t>(x * n) << 32) >> s;
 }
 
 // x + (y - x) a = (x (2^20 - a) + y a) / 2^20 (floored), a in [0, 1] as Q20: one step of de
@@ -161,16 +162,17 @@ void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
 void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const int32_t arm3[3]) {
     // The cubic from prev_q8_ (p0) to p3 whose control points are p0 + arm0 / 3 and
     // p3 - arm3 / 3, ticks x 256: relative to p0, c1 t + c2 t^2 + c3 t^3 with c1 = arm0,
-    // c2 = 3 D - 2 arm0 - arm3, c3 = arm0 + arm3 - 2 D, D = p3 - p0.
+    // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0.
     int32_t c[3][3];
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
     for (uint8_t a = 0; a < 3; ++a) {
         int32_t* k = c[a];
-        int32_t d = p3[a] - prev_q8_[a];
+        const int32_t d = p3[a] - prev_q8_[a];
         k[0] = arm0[a];
-        k[1] = 3 * d - 2 * arm0[a] - arm3[a];
         k[2] = arm0[a] + arm3[a] - 2 * d;
-        uint32_t b = abs32(k[0]) + 2 * abs32(k[1]) + 3 * abs32(k[2]);
+        k[1] = d - k[0] - k[2];
+        const uint32_t a2 = abs32(k[2]);
+        const uint32_t b = abs32(k[0]) + 2 * (abs32(k[1]) + a2) + a2;
         if (b > bound) bound = b;
     }
     // N = 2^m > bound (ticks): at most one tick per sample and axis.
@@ -179,20 +181,20 @@ void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const 
     left_ = static_cast<uint16_t>(1u << m);
     uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
     for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
+    const uint8_t m2 = static_cast<uint8_t>(2 * m), m3 = static_cast<uint8_t>(3 * m);
     for (uint8_t a = 0; a < 3; ++a) {
         int64_t* v = fd_[a];
         const int32_t* k = c[a];
         base_[a] = prev_q8_[a] >> 8;
-        add_q40(v[0], prev_q8_[a] & 0xFF, 0);
-        // Differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3, 2 c2/N^2 + 6 c3/N^3,
-        // 6 c3/N^3.
-        uint8_t s = 0;
-        for (uint8_t i = 0; i < 3; ++i) {
-            s = static_cast<uint8_t>(s + m);
-            add_q40(v[1], k[i], s);
-            if (i != 0) add_q40(v[2], (i == 1 ? 2 : 6) * k[i], s);
-        }
-        add_q40(v[3], 6 * k[2], s);
+        // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
+        // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3.
+        add_q40(v[0], prev_q8_[a] & 0xFF, 0, 1);
+        add_q40(v[1], k[0], m, 1);
+        add_q40(v[1], k[1], m2, 1);
+        add_q40(v[1], k[2], m3, 1);
+        add_q40(v[2], k[1], m2, 2);
+        add_q40(v[2], k[2], m3, 6);
+        add_q40(v[3], k[2], m3, 6);
         prev_q8_[a] = p3[a];
     }
 }

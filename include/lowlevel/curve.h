@@ -11,11 +11,11 @@
 // and since N is a power of two the differences are set up with shifts.
 //
 // Arcs and ellipses (X = cu + ru cos t, Y = cv + rv sin t, docs/curves.md): pieces of at most
-// 22.5 degrees (and 2000 ticks), each the cubic whose arms are 4/3 tan(h/4) long, which stays
+// 21.5 degrees (and 2000 ticks), each the cubic whose arms are 4/3 tan(h/4) long, which stays
 // within 7e-8 radius of the true curve; the unit vector (cos t, sin t) is advanced from piece to
 // piece by an integer rotation whose sine and cosine come from their series where the arc is
 // prepared. Beziers are cut into 2^j pieces of equal parameter length, each exactly the
-// corresponding part of the curve (its ends and tangents evaluated by Horner's rule).
+// corresponding part of the curve (its ends and tangents by de Casteljau's algorithm).
 #pragma once
 
 #include "lowlevel/config.h"
