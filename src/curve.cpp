@@ -244,7 +244,8 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
 }
 
 void CurveWalker::bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const {
-    // B(a), and B'(a) / 2^j: 3 x the arm of the piece that starts or ends there (ticks x 256),
+    // B(a) (with `point`), and B'(a) / 2^j: 3 x the arm of the piece that starts or ends there
+    // (ticks x 256),
     // by de Casteljau's algorithm: every value stays within the control points' hull.
     for (uint8_t k = 0; k < 2; ++k) {
         int32_t q[4];
@@ -252,7 +253,7 @@ void CurveWalker::bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) co
         for (uint8_t n = 3; n > 1; --n) {
             for (uint8_t i = 0; i < n; ++i) q[i] = lerp(q[i], q[i + 1], a_q20);
         }
-        point[k] = lerp(q[0], q[1], a_q20);
+        if (point) point[k] = lerp(q[0], q[1], a_q20);
         // B'(a) = 3 (q1 - q0), with q1 - q0 below 2^31 in magnitude (as the points' differences).
         int32_t d = static_cast<int32_t>(static_cast<uint32_t>(q[1]) - static_cast<uint32_t>(q[0]));
         arm[k] = static_cast<int32_t>((static_cast<int64_t>(d) * 3) >> log_pieces_);
@@ -316,7 +317,7 @@ bool CurveWalker::next_piece() {
     } else {
         // Bezier part [a, a + 1/n]: the curve's ends and tangents.
         uint32_t a0 = static_cast<uint32_t>(index) << (20 - log_pieces_);
-        bezier_at(a0, p3, arm0);
+        bezier_at(a0, nullptr, arm0); // (the start is the last piece's end)
         bezier_at(a0 + (1ul << (20 - log_pieces_)), p3, arm3);
         if (last) { // the commanded end
             p3[0] = pts_[0][3];
