@@ -467,15 +467,14 @@ Num norm(const int32_t v[2], const Num& z2) {
 }
 
 // The unit tangent (P', w') / |(P', w')| at the current point, Q29. Where P' = 0 (a Bezier whose
-// end arm is null), along the next arm: P''(0) or -P''(1), halved to the arm's scale.
+// end arm is null), P' a little inside the curve (2^-12 of t): the direction of P''(0), or of
+// -P''(1), to 2^-12 |P'''| / |P''| rad.
 void tangent(Track& k, int32_t out[3]) {
     int32_t d[2], d2[2];
     track_at(k, 0, false, d, d2);
-    if (d[0] == 0 && d[1] == 0) {
-        for (uint8_t i = 0; i < 2; ++i) {
-            d[i] = d2[i] >> 1;
-            if (k.b.t) d[i] = -d[i];
-        }
+    if ((d[0] | d[1]) == 0) {
+        const uint32_t in = kOneQ29 >> 12; // backwards from t = 1: modulo 2^32
+        track_at(k, k.b.t ? static_cast<uint32_t>(0u - in) : in, false, d, d2);
     }
     Num x(abs32(d[0])), y(abs32(d[1])), rr = k.rise;
     Num n = hypot(x, y, rr.mul(k.rise));

@@ -538,3 +538,33 @@ TEST(CurveShape, RandomBeziersAndTheirHelicesWithinTenToTheMinusFive) {
                 "found %.3f .. %.3f x the true one\n",
                 worst, rmin_low, rmin_high);
 }
+
+TEST(CurveShape, NullEndArmsTakeTheDirectionOfTheNextArm) {
+    // p1 = p0 and p2 = p3: the curve leaves along p2 - p0 and arrives along p3 - p1.
+    ll::CurveParams p{};
+    p.kind = ll::kCurveBezier;
+    p.start_um[0] = 0;
+    p.start_um[1] = 0;
+    p.a_um[0] = 0;
+    p.a_um[1] = 0;
+    p.b_um[0] = 30000;
+    p.b_um[1] = 40000;
+    p.end_um[0] = 30000;
+    p.end_um[1] = 40000;
+    ll::CurveShape sh;
+    ASSERT_TRUE(ll::curve_shape(p, 0, true, sh));
+    const double q = std::ldexp(1.0, 29);
+    EXPECT_NEAR(sh.start_dir[0] / q, 0.6, 1e-4);
+    EXPECT_NEAR(sh.start_dir[1] / q, 0.8, 1e-4);
+    EXPECT_NEAR(sh.end_dir[0] / q, 0.6, 1e-4);
+    EXPECT_NEAR(sh.end_dir[1] / q, 0.8, 1e-4);
+    EXPECT_EQ(sh.start_dir[2], 0);
+    // A general one: p1 = p0, the start along p2 - p0.
+    p.b_um[0] = 10000;
+    p.b_um[1] = -20000;
+    p.end_um[0] = 40000;
+    p.end_um[1] = 10000;
+    ASSERT_TRUE(ll::curve_shape(p, 0, true, sh));
+    EXPECT_NEAR(sh.start_dir[0] / q, 1 / std::sqrt(5.0), 1e-3);
+    EXPECT_NEAR(sh.start_dir[1] / q, -2 / std::sqrt(5.0), 1e-3);
+}
