@@ -244,9 +244,9 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
 }
 
 void CurveWalker::bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const {
-    // B(a) (with `point`), and B'(a) / 2^j: 3 x the arm of the piece that starts or ends there
-    // (ticks x 256),
-    // by de Casteljau's algorithm: every value stays within the control points' hull.
+    // B(a) (with `point`) and B'(a) / 2^j, 3 x the arm of the piece that starts or ends there
+    // (ticks x 256), by de Casteljau's algorithm: every value stays within the control points'
+    // hull.
     for (uint8_t k = 0; k < 2; ++k) {
         int32_t q[4];
         for (uint8_t i = 0; i < 4; ++i) q[i] = pts_[k][i];
@@ -366,8 +366,9 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
 uint16_t CurveWalker::peek(int32_t d[3]) {
     while (left_ == 0 && kind_ != 0 && pieces_ != 0) next_piece();
     // d1 / 2^24 (below 2^17): bits 24 to 55 of the little-endian word.
-    for (uint8_t a = 0; a < 3; ++a)
+    for (uint8_t a = 0; a < 3; ++a) {
         memcpy(&d[a], reinterpret_cast<const uint8_t*>(&fd_[a][1]) + 3, 4);
+    }
     return left_;
 }
 
@@ -502,7 +503,10 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
             if (k.rmin.m == 0 || rc.cmp(k.rmin) < 0) k.rmin = rc;
         }
     }
-    if (half) *half = Num(n1).div(norm(d2, Num{})).shift(28).u32(); // 0 / 0 when P'' = 0
+    if (half) {
+        Num n2 = norm(d2, Num{});
+        *half = n2.m ? Num(n1).div(n2).shift(28).u32() : 0xFFFFFFFFul; // P'' = 0: a line
+    }
     return k.ww.m ? norm(d1, k.ww) : n1;
 }
 
@@ -516,7 +520,7 @@ Num track_length(Track& k, uint32_t span, uint32_t widest) {
     uint32_t w;
     probe(k, 0, false, &w);
     while (span != 0) {
-        if (w == 0 || w > widest) w = widest;
+        if (w > widest) w = widest;
         if (w < kNarrowestQ29) w = kNarrowestQ29;
         if (w > span) w = span;
         // Nodes at g, w / 2 and w - g, weights 5, 8, 5 (/ 18).

@@ -568,3 +568,32 @@ TEST(CurveShape, NullEndArmsTakeTheDirectionOfTheNextArm) {
     EXPECT_NEAR(sh.start_dir[0] / q, 1 / std::sqrt(5.0), 1e-3);
     EXPECT_NEAR(sh.start_dir[1] / q, -2 / std::sqrt(5.0), 1e-3);
 }
+
+TEST(CurveShape, BezierWithACuspHasItsLength) {
+    // (0,0) (10,10) (0,10) (10,0) mm: B'(1/2) = 0, a cusp, where |B'| has a kink; the panels
+    // narrow towards it from both sides.
+    ll::CurveParams p{};
+    p.kind = ll::kCurveBezier;
+    p.a_um[0] = 10000;
+    p.a_um[1] = 10000;
+    p.b_um[0] = 0;
+    p.b_um[1] = 10000;
+    p.end_um[0] = 10000;
+    ll::CurveShape sh;
+    ASSERT_TRUE(ll::curve_shape(p, 0, true, sh));
+    double q[4][2] = {{0, 0}, {10, 10}, {0, 10}, {10, 0}};
+    double want = 0;
+    const int n = 400000;
+    for (int i = 0; i < n; ++i) {
+        double t = (i + 0.5) / n, s = 1 - t, d[2];
+        for (int k = 0; k < 2; ++k) {
+            d[k] = 3 * s * s * (q[1][k] - q[0][k]) + 6 * s * t * (q[2][k] - q[1][k]) +
+                   3 * t * t * (q[3][k] - q[2][k]);
+        }
+        want += std::hypot(d[0], d[1]) / n;
+    }
+    std::printf("cusp: %.6f mm, exact %.6f mm, smallest radius %u µm\n", sh.len_q8 / 256000.0, want,
+                sh.min_radius_um);
+    EXPECT_NEAR(sh.len_q8 / 256000.0 / want, 1.0, 1e-5);
+    EXPECT_LT(sh.min_radius_um, 10u); // at the cusp, 0
+}
