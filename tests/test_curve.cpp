@@ -374,7 +374,7 @@ TEST(CurveShape, HelixLengthAddsTheRiseInQuadrature) {
     EXPECT_NEAR(sh.start_dir[2] / std::ldexp(1.0, 29), 5.0 / std::hypot(2 * kPi * 10, 5.0), 1e-4);
 }
 
-TEST(CurveShape, EllipseLengthComesFromAdaptiveSimpsonWithinTenToTheMinusFive) {
+TEST(CurveShape, EllipseLengthComesFromQuadratureWithinTenToTheMinusFive) {
     // Quarter of the ellipse 30 x 10 from (30, 0) to (0, 10), and a whole 50 x 5 one.
     ll::CurveShape sh;
     ASSERT_TRUE(ll::curve_shape(arc_params(30, 0, 0, 10, 0, 0, 30, 10, false), 0, true, sh));
@@ -421,7 +421,7 @@ TEST(CurveShape, BezierLengthAndCurvatureMatchNumericReferences) {
     std::printf("bezier: %.5f mm (exact %.5f), min radius %.3f mm (exact %.3f)\n",
                 sh.len_q8 / 256000.0, len, sh.min_radius_um / 1000.0, rmin);
     EXPECT_NEAR(sh.len_q8 / 256000.0 / len, 1.0, 1e-5);
-    // Sampled at 33 points, the smallest radius is found to within the sampling.
+    // Sampled at every quadrature node, the smallest radius is found to within the sampling.
     EXPECT_NEAR(sh.min_radius_um / 1000.0 / rmin, 1.0, 0.1);
 }
 
