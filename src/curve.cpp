@@ -1,200 +1,290 @@
 #include "lowlevel/curve.h"
 
 #include "lowlevel/fixmath.h"
+#include "lowlevel/pgm.h"
+
+#include <string.h>
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the walker reads the high word of int64");
+
+// Size on the ATmega328P: every 64-bit addition, shift or product is a library call wrapped in
+// long register moves, and every Num operation a call sequence. So these operations are written
+// once, in the out-of-line helpers below, and the axes are loops, not copies.
 
 namespace ll {
 namespace {
 
-constexpr int32_t kOneQ30 = 1l << 30;
 constexpr int32_t kOneQ29 = 1l << 29;
-// Largest piece of an arc: 22.5 degrees (radius error of its cubic: 7e-8 R) ...
-constexpr int32_t kMaxPieceAngleQ29 = kPiQ29 / 8;
-// ... and at most this many ticks long, so that N <= 4096 samples keep the forward-difference
-// error below 0.02 tick.
+constexpr uint32_t kTurnQ29 = 2ul * kPiQ29;
+// Pieces of an arc are at most 21.5 degrees (their cubic is within 7e-8 R of the ellipse) and at
+// most this many ticks long, so that N <= 4096 samples keep the forward-difference error below
+// 0.02 tick.
 constexpr uint32_t kMaxPieceTicks = 2000;
 
-int32_t mul_q30(int32_t a, int32_t b) {
+// (a b) >> 30: products of Q30 factors, and Q8 coordinates times Q30 factors.
+__attribute__((noinline)) int32_t mul_q30(int32_t a, int32_t b) {
     return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> 30);
 }
 
-// A Q8 coordinate times a Q30 factor, Q8.
-int32_t scale_q30(int32_t v_q8, int32_t f_q30) {
-    return static_cast<int32_t>((static_cast<int64_t>(v_q8) * f_q30) >> 30);
+// Forward differences in place: (p0, p1, p2, p3) -> (p0, p1 - p0, p2 - 2 p1 + p0, p3 - 3 p2 + ...).
+void differences(int32_t q[4]) {
+    for (uint8_t i = 1; i < 4; ++i) {
+        for (uint8_t j = 3; j >= i; --j) q[j] -= q[j - 1];
+    }
 }
 
-// round(x / 2^40) for the forward-difference accumulator.
-int32_t round_q40(int64_t x) {
-    return static_cast<int32_t>((x + (1ll << 39)) >> 40);
+// Taylor coefficients (Q30) of cos x, sin x / x and tan x / x as polynomials in x^2, with the
+// signs of cos and sin taken by evaluating at -x^2. For |x| <= 0.4 rad the first term left out is
+// below 2^-31.
+const uint32_t kSeriesQ30[3][5] LL_PROGMEM = {
+    {1073741824, 536870912, 44739243, 1491308, 26631},       // 1, 1/2, 1/24, 1/720, 1/40320
+    {1073741824, 178956971, 8947849, 213044, 2959},          // 1, 1/6, 1/120, 1/5040, 1/362880
+    {1073741824, 357913941, 143165577, 57947971, 23482185}}; // 1, 1/3, 2/15, 17/315, 62/2835
+
+// Series `which` of kSeriesQ30 at y (Horner's rule), Q30.
+int32_t series(uint8_t which, int32_t y) {
+    int32_t r = 0;
+    for (uint8_t i = 5; i-- > 0;) {
+        r = static_cast<int32_t>(flash_read_u32(&kSeriesQ30[which][i])) + mul_q30(r, y);
+    }
+    return r;
+}
+
+// rot = (cos h, sin h) for |h| <= 0.4 rad, Q30.
+void rotation(int32_t h, int32_t rot[2]) {
+    int32_t y = -mul_q30(h, h);
+    rot[0] = series(0, y);
+    rot[1] = mul_q30(h, series(1, y));
+}
+
+// v = (cos t, sin t) turned by the angle of rot, Q30.
+void rotate(int32_t v[2], const int32_t rot[2]) {
+    int32_t c = mul_q30(v[0], rot[0]) - mul_q30(v[1], rot[1]);
+    v[1] = mul_q30(v[1], rot[0]) + mul_q30(v[0], rot[1]);
+    v[0] = c;
+}
+
+// sqrt(a^2 + b^2 + cc).
+Num hypot(Num a, Num b, const Num& cc) {
+    a.mul(a);
+    b.mul(b);
+    return a.add(b).add(cc).sqrt();
+}
+
+// num / den as a signed fixed-point value with `bits` fraction bits, at most 1 in magnitude.
+__attribute__((noinline)) int32_t unit_part(Num num, const Num& den, bool negative, uint8_t bits) {
+    uint32_t u = num.div(den).shift(static_cast<int8_t>(bits)).u32();
+    if (u > (1ul << bits)) u = 1ul << bits;
+    return negative ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+}
+
+// |sweep| in (0, 2 pi] from the angle a0 to the angle a1 (radians x 2^29, in (-pi, pi]),
+// clockwise or not: a closed arc is a full turn. The difference is taken modulo 2^32, where the
+// result (below 2^32) is exact.
+uint32_t sweep_q29(int32_t a0, int32_t a1, bool clockwise) {
+    if (clockwise) {
+        int32_t t = a0;
+        a0 = a1;
+        a1 = t;
+    }
+    uint32_t d = static_cast<uint32_t>(a1) - static_cast<uint32_t>(a0);
+    return a1 > a0 ? d : d + kTurnQ29;
+}
+
+// Directions (cos t, sin t) of an arc's start and end seen from its centre in the ellipse's
+// scale (Q30), and its sweep without the extra turns (radians x 2^29).
+uint32_t arc_directions(const int32_t start[2], const int32_t end[2], const int32_t centre[2],
+                        const uint32_t radii[2], bool clockwise, int32_t dir[2][2]) {
+    const int32_t* pt[2] = {start, end};
+    int32_t a[2];
+    for (uint8_t i = 0; i < 2; ++i) {
+        ellipse_direction(pt[i][0] - centre[0], pt[i][1] - centre[1], radii, dir[i][0], dir[i][1]);
+        a[i] = atan2_q29(dir[i][1], dir[i][0]);
+    }
+    return sweep_q29(a[0], a[1], clockwise);
+}
+
+// One sample of a cubic by forward differencing: f += d1, d1 += d2, d2 += d3 (v = f, d1, d2, d3).
+inline void fd_step(int64_t v[4]) {
+    v[0] += v[1];
+    v[1] += v[2];
+    v[2] += v[3];
+}
+
+// acc += n x / 2^s in Q40 for x in Q8 (n x below 2^31, s <= 36): exact for s <= 32, floored
+// beyond.
+__attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s, uint8_t n) {
+    acc += (static_cast<int64_t>(x * n) << 32) >> s;
+}
+
+// x + (y - x) a = (x (2^20 - a) + y a) / 2^20 (floored), a in [0, 1] as Q20: one step of de
+// Casteljau's algorithm, exact in 64 bits.
+__attribute__((noinline)) int32_t lerp(int32_t x, int32_t y, uint32_t a_q20) {
+    return static_cast<int32_t>(
+        (static_cast<int64_t>(x) * static_cast<int32_t>((1ul << 20) - a_q20) +
+         static_cast<int64_t>(y) * static_cast<int32_t>(a_q20)) >>
+        20);
 }
 
 } // namespace
 
 void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], int32_t& c,
                        int32_t& s) {
-    Num a(abs32(x_q8)), b(abs32(y_q8));
-    a.div(radii_q8[0]);
-    b.div(radii_q8[1]);
-    Num aa = a, bb = b;
-    aa.mul(a);
-    bb.mul(b);
-    Num n = aa.add(bb).sqrt();
-    uint32_t ca = a.div(n).shift(30).u32(), sb = b.div(n).shift(30).u32();
-    if (ca > static_cast<uint32_t>(kOneQ30)) ca = kOneQ30;
-    if (sb > static_cast<uint32_t>(kOneQ30)) sb = kOneQ30;
-    c = x_q8 < 0 ? -static_cast<int32_t>(ca) : static_cast<int32_t>(ca);
-    s = y_q8 < 0 ? -static_cast<int32_t>(sb) : static_cast<int32_t>(sb);
+    const int32_t v[2] = {x_q8, y_q8};
+    Num q[2];
+    for (uint8_t k = 0; k < 2; ++k) q[k] = Num(abs32(v[k])).div(radii_q8[k]);
+    Num n = hypot(q[0], q[1], Num{});
+    c = unit_part(q[0], n, x_q8 < 0, 30);
+    s = unit_part(q[1], n, y_q8 < 0, 30);
 }
 
 int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clockwise,
                       uint8_t turns) {
-    int64_t sweep = static_cast<int64_t>(atan2_q29(s1, c1)) - atan2_q29(s0, c0);
-    const int64_t turn = 2ll * kPiQ29;
-    if (clockwise) {
-        while (sweep >= 0) sweep -= turn; // a closed arc is a full turn
-        sweep -= turns * turn;
-    } else {
-        while (sweep <= 0) sweep += turn;
-        sweep += turns * turn;
-    }
-    return sweep;
+    int64_t sweep = sweep_q29(atan2_q29(s0, c0), atan2_q29(s1, c1), clockwise);
+    while (turns--) sweep += kTurnQ29;
+    return clockwise ? -sweep : sweep;
 }
 
-void CurveWalker::start_piece(const int32_t p0[3], const int32_t p1[3], const int32_t p2[3],
-                              const int32_t p3[3]) {
-    // Polynomial of the piece relative to its start (ticks x 256): d1 t + d2 t^2 + d3 t^3.
-    int32_t d1[3], d2[3], d3[3];
+void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
+    for (uint8_t a = 0; a < 3; ++a) {
+        pos[a] = e.start[a];
+        end_[a] = e.end[a];
+        prev_q8_[a] = a < 2 ? p0_q8[a] : e.start[2] * 256;
+    }
+    // w moves linearly along the curve (a helix); without it, only u and v are walked.
+    w0_q8_ = prev_q8_[2];
+    dw_q8_ = e.end[2] * 256 - w0_q8_;
+    axes_ = dw_q8_ ? 3 : 2;
+    kind_ = kind;
+    left_ = 0;
+}
+
+void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const int32_t arm3[3]) {
+    // The cubic from prev_q8_ (p0) to p3 whose control points are p0 + arm0 / 3 and
+    // p3 - arm3 / 3, ticks x 256: relative to p0, c1 t + c2 t^2 + c3 t^3 with c1 = arm0,
+    // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0.
+    int32_t c[3][3];
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
     for (uint8_t a = 0; a < 3; ++a) {
-        d1[a] = 3 * (p1[a] - p0[a]);
-        d2[a] = 3 * (p0[a] - 2 * p1[a] + p2[a]);
-        d3[a] = p3[a] - p0[a] + 3 * (p1[a] - p2[a]);
-        uint32_t b = abs32(d1[a]) + 2 * abs32(d2[a]) + 3 * abs32(d3[a]);
+        int32_t* k = c[a];
+        const int32_t d = p3[a] - prev_q8_[a];
+        k[0] = arm0[a];
+        k[2] = arm0[a] + arm3[a] - 2 * d;
+        k[1] = d - k[0] - k[2];
+        const uint32_t a2 = abs32(k[2]);
+        const uint32_t b = abs32(k[0]) + 2 * (abs32(k[1]) + a2) + a2;
         if (b > bound) bound = b;
     }
     // N = 2^m > bound (ticks): at most one tick per sample and axis.
     uint8_t m = 0;
     while ((1ul << (m + 8)) <= bound) ++m;
     left_ = static_cast<uint16_t>(1u << m);
+    uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
+    for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
+    const uint8_t m2 = static_cast<uint8_t>(2 * m), m3 = static_cast<uint8_t>(3 * m);
     for (uint8_t a = 0; a < 3; ++a) {
-        base_[a] = p0[a] >> 8;
-        int64_t n1 = static_cast<int64_t>(d1[a]) << 32, n2 = static_cast<int64_t>(d2[a]) << 32,
-                n3 = static_cast<int64_t>(d3[a]) << 32;
-        f_[a] = static_cast<int64_t>(p0[a] & 0xFF) << 32;
-        d1_[a] = (n1 >> m) + (n2 >> (2 * m)) + (n3 >> (3 * m));
-        d2_[a] = 2 * (n2 >> (2 * m)) + 6 * (n3 >> (3 * m));
-        d3_[a] = 6 * (n3 >> (3 * m));
+        int64_t* v = fd_[a];
+        const int32_t* k = c[a];
+        base_[a] = prev_q8_[a] >> 8;
+        // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
+        // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3.
+        add_q40(v[0], prev_q8_[a] & 0xFF, 0, 1);
+        add_q40(v[1], k[0], m, 1);
+        add_q40(v[1], k[1], m2, 1);
+        add_q40(v[1], k[2], m3, 1);
+        add_q40(v[2], k[1], m2, 2);
+        add_q40(v[2], k[2], m3, 6);
+        add_q40(v[3], k[2], m3, 6);
         prev_q8_[a] = p3[a];
     }
 }
 
-void CurveWalker::arc_point(int32_t c, int32_t s, int32_t out[2]) const {
-    out[0] = a_.centre[0] + scale_q30(static_cast<int32_t>(a_.radii[0]), c);
-    out[1] = a_.centre[1] + scale_q30(static_cast<int32_t>(a_.radii[1]), s);
+void CurveWalker::arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const {
+    // X = cu + ru cos t, Y = cv + rv sin t; the arm is the tangent (-ru sin t, rv cos t) times
+    // 4 tan(h/4).
+    for (uint8_t k = 0; k < 2; ++k) {
+        int32_t r = static_cast<int32_t>(a_.radii[k]);
+        point[k] = a_.centre[k] + mul_q30(r, dir[k]);
+        arm[k] = mul_q30(mul_q30(r, k ? dir[0] : -dir[1]), a_.arm);
+    }
 }
 
 bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t radii_q8[2],
                       bool clockwise, uint8_t turns) {
-    const int32_t* start = e.start;
-    const int32_t* end = e.end;
     kind_ = 0;
     if (radii_q8[0] == 0 || radii_q8[1] == 0) return false;
-    for (uint8_t a = 0; a < 2; ++a) {
-        a_.centre[a] = centre_q8[a];
-        a_.radii[a] = radii_q8[a];
+    for (uint8_t k = 0; k < 2; ++k) {
+        a_.centre[k] = centre_q8[k];
+        a_.radii[k] = radii_q8[k];
     }
-    for (uint8_t a = 0; a < 3; ++a) {
-        pos[a] = start[a];
-        end_[a] = end[a];
-    }
-    // Directions of the start and end points (their projections on the curve), and the sweep.
-    ellipse_direction(e.start_q8[0] - a_.centre[0], e.start_q8[1] - a_.centre[1], a_.radii, a_.c,
-                      a_.s);
-    ellipse_direction(e.end_q8[0] - a_.centre[0], e.end_q8[1] - a_.centre[1], a_.radii, end_c_,
-                      end_s_);
-    int64_t sweep = arc_sweep_q29(a_.c, a_.s, end_c_, end_s_, clockwise, turns);
-    // Pieces: at most 22.5 degrees and kMaxPieceTicks long.
-    uint64_t mag = static_cast<uint64_t>(sweep < 0 ? -sweep : sweep);
+    // Directions of the start and end points (their projections on the curve), and the sweep
+    // with the extra turns, radians x 2^20 (below 2^31 for 255 turns).
+    uint32_t mag =
+        (arc_directions(e.start_q8, e.end_q8, a_.centre, a_.radii, clockwise, a_.dir) >> 9) +
+        turns * (kTurnQ29 >> 9);
+    // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees) and kMaxPieceTicks long (sweep x
+    // radius ticks).
     uint32_t rmax = (a_.radii[0] > a_.radii[1] ? a_.radii[0] : a_.radii[1]) >> 8;
-    // The sweep is below 2^40 (255 turns), so these quotients are of small numbers.
-    uint32_t by_angle = static_cast<uint32_t>(mag >> 26) / (kMaxPieceAngleQ29 >> 26) + 1;
-    // length = sweep x radius = (mag / 2^29) rmax ticks, over kMaxPieceTicks
-    uint64_t len = (mag >> 13) * (rmax + 1); // ticks x 2^16
-    uint32_t by_length = static_cast<uint32_t>(len >> 16) / kMaxPieceTicks + 1;
-    uint32_t n = by_angle > by_length ? by_angle : by_length;
+    uint32_t n = static_cast<uint16_t>(mag >> 17) / 3u + 1u;
+    uint32_t by_length = Num(mag, -20).mul(rmax + 1).div(kMaxPieceTicks).u32() + 1;
+    if (by_length > n) n = by_length;
     if (n > 0xFFFF) return false;
     piece_count_ = pieces_ = static_cast<uint16_t>(n);
-    // Piece angle, Q30 (at most 22.5 degrees, so the series apply).
-    int32_t h = static_cast<int32_t>(Num(static_cast<uint32_t>(mag >> 10)).div(n).shift(11).u32());
-    if (sweep < 0) h = -h;
-    small_angle_q30(h, a_.rot_c, a_.rot_s, a_.arm);
-    // Helix axis: linear along the curve.
-    w0_q8_ = start[2] * 256;
-    dw_q8_ = (end[2] - start[2]) * 256;
-    int32_t p[2];
-    arc_point(a_.c, a_.s, p);
-    prev_q8_[0] = p[0];
-    prev_q8_[1] = p[1];
-    prev_q8_[2] = w0_q8_;
-    kind_ = 1;
-    left_ = 0;
+    // Piece angle h, Q30 (at most 21.5 degrees, so the series apply), and 3 x the arm of its
+    // cubic per unit of radius, 4 tan(h/4).
+    int32_t h = static_cast<int32_t>(Num(mag).div(n).shift(10).u32());
+    if (clockwise) h = -h;
+    rotation(h, a_.rot);
+    int32_t x = h >> 2;
+    a_.arm = 4 * mul_q30(x, series(2, mul_q30(x, x)));
+    int32_t p[2], arm[2];
+    arc_at(a_.dir[0], p, arm);
+    begin(e, p, 1);
     return true;
 }
 
-void CurveWalker::bezier_point(uint32_t a_q20, int32_t out[2], int32_t slope[2]) const {
-    // slope: B'(a) / 2^j (the tangent over one piece), ticks x 256.
-    // Horner's rule in 64-bit fixed point, a in [0, 1] as Q20.
+void CurveWalker::bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const {
+    // B(a) (with `point`) and B'(a) / 2^j, 3 x the arm of the piece that starts or ends there
+    // (ticks x 256), by de Casteljau's algorithm: every value stays within the control points'
+    // hull.
     for (uint8_t k = 0; k < 2; ++k) {
-        int64_t b = poly_[3][k];
-        b = ((b * a_q20) >> 20) + poly_[2][k];
-        b = ((b * a_q20) >> 20) + poly_[1][k];
-        b = ((b * a_q20) >> 20) + poly_[0][k];
-        out[k] = static_cast<int32_t>(b);
-        int64_t d = 3 * poly_[3][k];
-        d = ((d * a_q20) >> 20) + 2 * poly_[2][k];
-        d = ((d * a_q20) >> 20) + poly_[1][k];
-        slope[k] = static_cast<int32_t>(d >> log_pieces_);
+        int32_t q[4];
+        for (uint8_t i = 0; i < 4; ++i) q[i] = pts_[k][i];
+        for (uint8_t n = 3; n > 1; --n) {
+            for (uint8_t i = 0; i < n; ++i) q[i] = lerp(q[i], q[i + 1], a_q20);
+        }
+        if (point) point[k] = lerp(q[0], q[1], a_q20);
+        // B'(a) = 3 (q1 - q0), with q1 - q0 below 2^31 in magnitude (as the points' differences).
+        int32_t d = static_cast<int32_t>(static_cast<uint32_t>(q[1]) - static_cast<uint32_t>(q[0]));
+        arm[k] = static_cast<int32_t>((static_cast<int64_t>(d) * 3) >> log_pieces_);
     }
 }
 
 bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2_q8[2]) {
-    const int32_t* start = e.start;
-    const int32_t* end = e.end;
     kind_ = 0;
-    uint64_t bound = 0;
-    for (uint8_t a = 0; a < 3; ++a) {
-        pos[a] = start[a];
-        end_[a] = end[a];
-    }
+    uint32_t bound = 0; // hodograph bound (power basis), ticks
     for (uint8_t k = 0; k < 2; ++k) {
-        int64_t p0 = e.start_q8[k], p3 = e.end_q8[k];
-        poly_[0][k] = p0;
-        poly_[1][k] = 3 * (p1_q8[k] - p0);
-        poly_[2][k] = 3 * (p0 - 2 * static_cast<int64_t>(p1_q8[k]) + p2_q8[k]);
-        poly_[3][k] = p3 - p0 + 3 * (static_cast<int64_t>(p1_q8[k]) - p2_q8[k]);
-        uint64_t b = 0;
-        for (uint8_t i = 1; i < 4; ++i) {
-            int64_t c = poly_[i][k];
-            b += static_cast<uint64_t>(c < 0 ? -c : c) * i;
-        }
+        int32_t* q = pts_[k];
+        q[0] = e.start_q8[k];
+        q[1] = p1_q8[k];
+        q[2] = p2_q8[k];
+        q[3] = e.end_q8[k];
+        // B'(a) = 3 D1 + 6 D2 a + 3 D3 a^2 (D: the forward differences of the points, ticks).
+        int32_t d[4];
+        for (uint8_t i = 0; i < 4; ++i) d[i] = q[i] >> 8;
+        differences(d);
+        uint32_t b = 3 * (abs32(d[1]) + 2 * abs32(d[2]) + abs32(d[3]));
         if (b > bound) bound = b;
     }
     // 2^j pieces, each with a hodograph bound below kMaxPieceTicks (it shrinks with 2^j).
     uint8_t j = 0;
-    while (((bound >> 8) >> j) >= kMaxPieceTicks) {
+    while ((bound >> j) >= kMaxPieceTicks) {
         if (j == 15) return false;
         ++j;
     }
     log_pieces_ = j;
     piece_count_ = pieces_ = static_cast<uint16_t>(1u << j);
-    w0_q8_ = start[2] * 256;
-    dw_q8_ = (end[2] - start[2]) * 256;
-    prev_q8_[0] = e.start_q8[0];
-    prev_q8_[1] = e.start_q8[1];
-    prev_q8_[2] = w0_q8_;
-    end_c_ = e.end_q8[0]; // the last piece lands on the commanded end
-    end_s_ = e.end_q8[1];
-    kind_ = 2;
-    left_ = 0;
+    begin(e, e.start_q8, 2);
     return true;
 }
 
@@ -203,55 +293,38 @@ bool CurveWalker::next_piece() {
     uint16_t index = static_cast<uint16_t>(piece_count_ - pieces_); // 0-based
     --pieces_;
     bool last = pieces_ == 0;
-    int32_t p0[3], p1[3], p2[3], p3[3];
-    for (uint8_t a = 0; a < 3; ++a) p0[a] = prev_q8_[a];
-    // Helix: w moves linearly, the last piece landing exactly on the end.
-    int32_t w3 = last ? dw_q8_ + w0_q8_
-                      : w0_q8_ + static_cast<int32_t>(Num(abs32(dw_q8_))
-                                                          .mul(static_cast<uint32_t>(index) + 1)
-                                                          .div(piece_count_)
-                                                          .u32()) *
-                                     (dw_q8_ < 0 ? -1 : 1);
-    p3[2] = w3;
-    p1[2] = p0[2] + (w3 - p0[2]) / 3;
-    p2[2] = w3 - (w3 - p0[2]) / 3;
+    // The end of the piece on the curve and 3 x its arms at both ends, ticks x 256.
+    int32_t p3[3], arm0[3], arm3[3];
+    // Helix: w moves linearly (arms of a third of its move), the last piece landing exactly on
+    // the end.
+    int32_t w3 = dw_q8_;
+    if (!last) {
+        w3 = static_cast<int32_t>(
+            Num(abs32(dw_q8_)).mul(static_cast<uint32_t>(index) + 1).div(piece_count_).u32());
+        if (dw_q8_ < 0) w3 = -w3;
+    }
+    p3[2] = w3 + w0_q8_;
+    arm0[2] = arm3[2] = p3[2] - prev_q8_[2];
     if (kind_ == 1) {
-        int32_t c = mul_q30(a_.c, a_.rot_c) - mul_q30(a_.s, a_.rot_s);
-        int32_t s = mul_q30(a_.s, a_.rot_c) + mul_q30(a_.c, a_.rot_s);
+        int32_t* dir = a_.dir[0];
+        arc_at(dir, p3, arm0);
+        rotate(dir, a_.rot);
         if (last) { // land on the end point's direction: no drift left over
-            c = end_c_;
-            s = end_s_;
+            dir[0] = a_.dir[1][0];
+            dir[1] = a_.dir[1][1];
         }
-        int32_t q[2];
-        arc_point(c, s, q);
-        p3[0] = q[0];
-        p3[1] = q[1];
-        // Arms along the tangents (dX/dt = -ru sin t, dY/dt = rv cos t), 4/3 tan(h/4) long.
-        int32_t arm = a_.arm;
-        p1[0] = p0[0] + scale_q30(scale_q30(static_cast<int32_t>(a_.radii[0]), -a_.s), arm);
-        p1[1] = p0[1] + scale_q30(scale_q30(static_cast<int32_t>(a_.radii[1]), a_.c), arm);
-        p2[0] = p3[0] - scale_q30(scale_q30(static_cast<int32_t>(a_.radii[0]), -s), arm);
-        p2[1] = p3[1] - scale_q30(scale_q30(static_cast<int32_t>(a_.radii[1]), c), arm);
-        a_.c = c;
-        a_.s = s;
+        arc_at(dir, p3, arm3);
     } else {
-        // Bezier part [a, a + 1/n]: ends and tangents of the curve, arms = slope / (3 n).
+        // Bezier part [a, a + 1/n]: the curve's ends and tangents.
         uint32_t a0 = static_cast<uint32_t>(index) << (20 - log_pieces_);
-        uint32_t a1 = static_cast<uint32_t>(index + 1) << (20 - log_pieces_);
-        int32_t q0[2], s0[2], q3[2], s3[2];
-        bezier_point(a0, q0, s0);
-        bezier_point(a1, q3, s3);
-        if (last) {
-            q3[0] = end_c_;
-            q3[1] = end_s_;
-        }
-        for (uint8_t k = 0; k < 2; ++k) {
-            p3[k] = q3[k];
-            p1[k] = p0[k] + s0[k] / 3;
-            p2[k] = p3[k] - s3[k] / 3;
+        bezier_at(a0, nullptr, arm0); // (the start is the last piece's end)
+        bezier_at(a0 + (1ul << (20 - log_pieces_)), p3, arm3);
+        if (last) { // the commanded end
+            p3[0] = pts_[0][3];
+            p3[1] = pts_[1][3];
         }
     }
-    start_piece(p0, p1, p2, p3);
+    start_piece(p3, arm0, arm3);
     return true;
 }
 
@@ -263,250 +336,281 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
             // Last step: from the rounded end of the curve to the exact target (at most one
             // tick per axis: both are within 0.71 tick of the curve's end point).
             kind_ = 0;
-            for (uint8_t a = 0; a < 3; ++a) {
-                if (pos[a] != end_[a]) {
-                    moved = static_cast<uint8_t>(moved | (1u << a));
-                    if (end_[a] < pos[a]) neg = static_cast<uint8_t>(neg | (1u << a));
-                    pos[a] = end_[a];
-                }
-            }
-            return moved != 0;
+            break;
         }
     }
-    --left_;
     for (uint8_t a = 0; a < 3; ++a) {
-        f_[a] += d1_[a];
-        d1_[a] += d2_[a];
-        d2_[a] += d3_[a];
-        int32_t p = base_[a] + round_q40(f_[a]);
+        int32_t p = end_[a];
+        if (kind_ != 0) {
+            if (a == axes_) break;
+            int64_t* v = fd_[a];
+            fd_step(v);
+            // round(f / 2^40) from the high word: floor((hi + 2^7) / 2^8). The word is read
+            // from memory: avr-gcc would shift the 64 bits through a library loop.
+            int32_t hi;
+            memcpy(&hi, reinterpret_cast<const uint8_t*>(v) + 4, 4);
+            p = base_[a] + ((hi + 128) >> 8);
+        }
         if (p != pos[a]) {
-            moved = static_cast<uint8_t>(moved | (1u << a));
-            if (p < pos[a]) neg = static_cast<uint8_t>(neg | (1u << a));
+            const uint8_t bit = static_cast<uint8_t>(1u << a);
+            moved = static_cast<uint8_t>(moved | bit);
+            if (p < pos[a]) neg = static_cast<uint8_t>(neg | bit);
             pos[a] = p;
         }
     }
+    if (kind_ == 0) return moved != 0;
+    --left_;
     return true;
 }
 
 uint16_t CurveWalker::peek(int32_t d[3]) {
     while (left_ == 0 && kind_ != 0 && pieces_ != 0) next_piece();
-    for (uint8_t a = 0; a < 3; ++a) d[a] = static_cast<int32_t>(d1_[a] >> 24);
+    // d1 / 2^24 (below 2^17): bits 24 to 55 of the little-endian word.
+    for (uint8_t a = 0; a < 3; ++a) {
+        memcpy(&d[a], reinterpret_cast<const uint8_t*>(&fd_[a][1]) + 3, 4);
+    }
     return left_;
 }
 
 namespace {
 
-// |(x, y, z)| for signed components.
-Num norm3(int32_t x, int32_t y, int32_t z) {
-    Num a(abs32(x)), b(abs32(y)), c(abs32(z));
-    Num aa = a, bb = b, cc = c;
-    return aa.mul(a).add(bb.mul(b)).add(cc.mul(c)).sqrt();
+// (1 - sqrt(3/5)) / 2, Q30: the outer Gauss-Legendre nodes of a panel [0, 1].
+constexpr int32_t kGaussQ30 = 121012492;
+// Panel width bounds, parameter units x 2^29: an ellipse's angle (the series apply up to 0.4
+// rad), a Bezier's t, and the narrowest panel (a cusp: |B'| -> 0).
+constexpr uint32_t kWidestArcQ29 = kPiQ29 / 8;
+constexpr uint32_t kWidestBezierQ29 = kOneQ29 / 16;
+constexpr uint32_t kNarrowestQ29 = kOneQ29 >> 16;
+
+// A curve as the length integral walks it: its first and second derivatives with respect to its
+// parameter, x 2^scale (scaled so that the largest coefficient has 28 bits: relative precision
+// whatever the size of the curve).
+struct Track {
+    bool bezier;
+    bool clockwise; ///< ellipse: the angle decreases
+    bool w_down;    ///< w decreases along the curve
+    union {
+        struct {
+            int32_t r[2];      ///< radii
+            int32_t dir[2][2]; ///< (cos t, sin t) of the current point and of the end, Q30
+        } e;                   ///< ellipse
+        struct {
+            uint32_t t;      ///< parameter of the current point, Q29
+            int32_t h[3][2]; ///< B'(t) = h0 + t (h1 + t h2)
+        } b;                 ///< Bezier
+    };
+    Num rise; ///< |dw / dparameter|: the helix' rise
+    Num ww;   ///< rise^2 when w counts in the length, else 0
+    Num rmin; ///< Bezier: smallest radius of curvature met so far (0: none)
+};
+
+// Shifts v[0..n-1] left or right so that the largest magnitude is in [2^27, 2^28); the shift.
+int8_t normalise(int32_t* v, uint8_t n) {
+    uint32_t big = 0;
+    for (uint8_t i = 0; i < n; ++i) {
+        if (abs32(v[i]) > big) big = abs32(v[i]);
+    }
+    int8_t sh = 0;
+    if (big == 0) return 0;
+    while (big >= (1ul << 28)) {
+        big >>= 1;
+        --sh;
+    }
+    while (big < (1ul << 27)) {
+        big <<= 1;
+        ++sh;
+    }
+    for (uint8_t i = 0; i < n; ++i) {
+        v[i] = sh < 0 ? v[i] >> -sh : static_cast<int32_t>(static_cast<uint32_t>(v[i]) << sh);
+    }
+    return sh;
 }
 
-// Unit vector of (x, y, z) in Q29.
-void unit3(int32_t x, int32_t y, int32_t z, int32_t out[3]) {
-    Num n = norm3(x, y, z);
-    const int32_t v[3] = {x, y, z};
-    for (uint8_t k = 0; k < 3; ++k) {
-        if (n.m == 0) {
-            out[k] = 0;
-            continue;
+// P' and P'' (x 2^scale) at `off` (Q29) past the current point; with `move`, that point becomes
+// the current one.
+void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
+    if (k.bezier) {
+        uint32_t t = k.b.t + off;
+        if (move) k.b.t = t;
+        int32_t t30 = static_cast<int32_t>(t << 1);
+        for (uint8_t i = 0; i < 2; ++i) {
+            int32_t q = k.b.h[1][i] + mul_q30(k.b.h[2][i], t30);
+            d1[i] = k.b.h[0][i] + mul_q30(q, t30);
+            d2[i] = q + mul_q30(k.b.h[2][i], t30);
         }
-        uint32_t u = Num(abs32(v[k])).div(n).shift(29).u32();
-        if (u > static_cast<uint32_t>(kOneQ29)) u = kOneQ29;
-        out[k] = v[k] < 0 ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+        return;
+    }
+    int32_t v[2] = {k.e.dir[0][0], k.e.dir[0][1]};
+    if (off) {
+        int32_t rot[2], h = static_cast<int32_t>(off << 1);
+        rotation(k.clockwise ? -h : h, rot);
+        rotate(v, rot);
+    }
+    if (move) {
+        k.e.dir[0][0] = v[0];
+        k.e.dir[0][1] = v[1];
+    }
+    // (-ru sin t, rv cos t), reversed when clockwise, and (-ru cos t, -rv sin t) (only its size
+    // is used).
+    if (k.clockwise) {
+        v[0] = -v[0];
+        v[1] = -v[1];
+    }
+    for (uint8_t i = 0; i < 2; ++i) {
+        d1[i] = mul_q30(k.e.r[i], i ? v[0] : -v[1]);
+        d2[i] = mul_q30(k.e.r[i], v[i]);
     }
 }
 
-// Tangent of the ellipse (ru cos t, rv sin t) at direction (c, s): (-ru s, rv c) µm per
-// radian, signed by the direction of travel.
-void ellipse_tangent(const uint32_t r[2], int32_t c, int32_t s, bool cw, int32_t& tu, int32_t& tv) {
-    tu = static_cast<int32_t>((static_cast<int64_t>(r[0]) * -s) >> 30);
-    tv = static_cast<int32_t>((static_cast<int64_t>(r[1]) * c) >> 30);
-    if (cw) {
-        tu = -tu;
-        tv = -tv;
-    }
+// |(x, y)| with z2 added under the root, for signed x, y.
+Num norm(const int32_t v[2], const Num& z2) {
+    return hypot(Num(abs32(v[0])), Num(abs32(v[1])), z2);
 }
 
-// Bezier B'(t) (u, v) at t in [0, 1] (Q20), from the control points p0..p3.
-void bezier_slope(const int32_t p[4][2], uint32_t t_q20, int32_t out[2]) {
-    for (uint8_t k = 0; k < 2; ++k) {
-        int64_t a = 3ll * (p[1][k] - p[0][k]), b = 3ll * (p[2][k] - p[1][k]),
-                c = 3ll * (p[3][k] - p[2][k]);
-        // De Casteljau on the hodograph (a, b, c): a quadratic Bezier.
-        int64_t u = 1ll << 20, t = t_q20;
-        // Rounded, not truncated: a floor would bias every slope (and the length) down.
-        const int64_t half = 1ll << 19;
-        int64_t ab = (a * (u - t) + b * t + half) >> 20, bc = (b * (u - t) + c * t + half) >> 20;
-        out[k] = static_cast<int32_t>((ab * (u - t) + bc * t + half) >> 20);
+// The unit tangent (P', w') / |(P', w')| at the current point, Q29. Where P' = 0 (a Bezier whose
+// end arm is null), P' a little inside the curve (2^-12 of t): the direction of P''(0), or of
+// -P''(1), to 2^-12 |P'''| / |P''| rad.
+void tangent(Track& k, int32_t out[3]) {
+    int32_t d[2], d2[2];
+    track_at(k, 0, false, d, d2);
+    if ((d[0] | d[1]) == 0) {
+        const uint32_t in = kOneQ29 >> 12; // backwards from t = 1: modulo 2^32
+        track_at(k, k.b.t ? static_cast<uint32_t>(0u - in) : in, false, d, d2);
     }
+    Num x(abs32(d[0])), y(abs32(d[1])), rr = k.rise;
+    Num n = hypot(x, y, rr.mul(k.rise));
+    if (n.m == 0) return; // out stays 0
+    out[0] = unit_part(x, n, d[0] < 0, 29);
+    out[1] = unit_part(y, n, d[1] < 0, 29);
+    out[2] = unit_part(k.rise, n, k.w_down, 29);
 }
 
-// Simpson's rule on k intervals (fine) and k/2 (coarse) at once: node i of k gets weight
-// 1, 4, 2, ... 4, 1 in the fine sum and, for even i, 1, 4, 2, ... 1 in the coarse one.
-void simpson_add(Num& fine, Num& coarse, Num f, uint32_t i, uint32_t k) {
-    Num g = f;
-    fine.add(i == 0 || i == k ? f : f.mul(i & 1 ? 4u : 2u));
-    if (i & 1) return;
-    uint32_t j = i / 2;
-    coarse.add(j == 0 || j == k / 2 ? g : g.mul(j & 1 ? 4u : 2u));
+// The track at `off` (Q29) past its current point, which with `move` becomes the current one:
+// returns the speed sqrt(|P'|^2 + w'^2) (x 2^scale) and, with `half`, |P'| / |P''| / 2 (Q29: the
+// widest panel there). On a Bezier, the radius of curvature |P'|^3 / |P' x P''| (x 2^scale) there
+// is kept in k.rmin when it is the smallest so far.
+Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
+    int32_t d1[2], d2[2];
+    track_at(k, off, move, d1, d2);
+    Num n1 = norm(d1, Num{});
+    if (k.bezier) {
+        // |P' x P''| / 2^30: both are below 2^30, and where the radius is smallest this keeps 20
+        // bits.
+        int32_t cross = mul_q30(d1[0], d2[1]) - mul_q30(d1[1], d2[0]);
+        if (cross != 0) {
+            Num rc = n1;
+            rc.mul(n1).mul(n1).div(abs32(cross)).shift(-30);
+            if (k.rmin.m == 0 || rc.cmp(k.rmin) < 0) k.rmin = rc;
+        }
+    }
+    if (half) {
+        Num n2 = norm(d2, Num{});
+        *half = n2.m ? Num(n1).div(n2).shift(28).u32() : 0xFFFFFFFFul; // P'' = 0: a line
+    }
+    return k.ww.m ? norm(d1, k.ww) : n1;
 }
 
-// Integral over an interval of length `width`: S = S_k + (S_k - S_k/2) / 15 (Richardson),
-// with S_k = width / (3k) * fine and S_k/2 = width / (3 k/2) * coarse.
-Num simpson_richardson(Num fine, Num coarse, Num width, uint32_t k) {
-    // 16 S_k - S_k/2 = width / (3k) (16 fine - 2 coarse), then / 15.
-    fine.mul(16);
-    coarse.mul(2);
-    Num r = fine;
-    if (fine.cmp(coarse) > 0) {
-        // fine - coarse without a subtraction routine: fine (1 - coarse / fine)
-        Num q = coarse;
-        q.div(fine);
-        uint32_t frac = q.shift(30).u32(); // < 2^30
-        r.mul(static_cast<uint32_t>((1ul << 30) - frac)).shift(-30);
+// Length of the track over `span` (Q29) from its current point, x 2^29 x 18 x 2^scale: panels
+// of 3 Gauss-Legendre nodes, each at most half the local scale |P'| / |P''| wide (so that the
+// nearest singularity of |P'| in the complex plane is at least two widths away: 1e-7 relative),
+// and at most `widest`. On a Bezier, the radii of curvature are sampled at every node and panel
+// end, and these crowd where the curve turns tightly.
+Num track_length(Track& k, uint32_t span, uint32_t widest) {
+    Num total{};
+    uint32_t w;
+    probe(k, 0, false, &w);
+    while (span != 0) {
+        if (w > widest) w = widest;
+        if (w < kNarrowestQ29) w = kNarrowestQ29;
+        if (w > span) w = span;
+        // Nodes at g, w / 2 and w - g, weights 5, 8, 5 (/ 18).
+        const uint32_t g = static_cast<uint32_t>(mul_q30(static_cast<int32_t>(w), kGaussQ30));
+        Num sum = probe(k, g, false, nullptr);
+        sum.add(probe(k, w - g, false, nullptr)).mul(5).add(probe(k, w / 2, false, nullptr).mul(8));
+        total.add(sum.mul(w));
+        span -= w;
+        probe(k, w, true, &w);
     }
-    return r.mul(width).div(3 * k).div(15);
+    return total;
+}
+
+// curve_shape() with its track passed in: the track is then reached through a pointer, not
+// through a stack frame too large for the AVR's displacement addressing.
+__attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated,
+                                     CurveShape& out, Track& k) {
+    k.w_down = dw_um < 0;
+    int8_t scale;
+    uint32_t span = kOneQ29, widest = kWidestBezierQ29;
+    uint8_t turns = 0;
+    bool circle = false;
+    Num len{};
+    if (cp.kind == kCurveArc) {
+        const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
+        if (r[0] == 0 || r[1] == 0) return false;
+        k.clockwise = cp.clockwise != 0;
+        // The sweep in (0, 2 pi], and with the extra full turns, radians.
+        span = arc_directions(cp.start_um, cp.end_um, cp.a_um, r, k.clockwise, k.e.dir);
+        widest = kWidestArcQ29;
+        turns = cp.turns;
+        len = Num(kTurnQ29, -29).mul(turns).add(Num(span, -29));
+        // w rises linearly with the angle: dw / |sweep| per radian.
+        k.rise = Num(abs32(dw_um)).div(len);
+        k.e.r[0] = static_cast<int32_t>(r[0]);
+        k.e.r[1] = static_cast<int32_t>(r[1]);
+        scale = normalise(k.e.r, 2);
+        const uint32_t lo = r[0] < r[1] ? r[0] : r[1];
+        const uint32_t hi = r[0] ^ r[1] ^ lo;
+        out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
+        circle = lo == hi;
+        len.mul(lo); // a circle: r |sweep|, and a helix: sqrt(plane^2 + dw^2)
+        if (w_regulated) len = hypot(len, Num(abs32(dw_um)), Num{});
+    } else {
+        // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
+        // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
+        // these fit. w rises by dw per unit of t.
+        const int32_t* p[4] = {cp.start_um, cp.a_um, cp.b_um, cp.end_um};
+        for (uint8_t i = 0; i < 2; ++i) {
+            int32_t q[4];
+            for (uint8_t j = 0; j < 4; ++j) q[j] = p[j][i];
+            differences(q);
+            for (uint8_t j = 0; j < 3; ++j) k.b.h[j][i] = (j == 1 ? 6 : 3) * q[j + 1];
+        }
+        scale = normalise(&k.b.h[0][0], 6);
+        k.bezier = true;
+        k.rise = Num(abs32(dw_um));
+    }
+    k.rise.shift(scale);
+    if (w_regulated) {
+        k.ww = k.rise;
+        k.ww.mul(k.rise);
+    }
+    tangent(k, out.start_dir);
+    if (!circle) { // ellipses and Beziers by quadrature
+        len = track_length(k, span, widest);
+        // An ellipse's extra turns: a full turn from wherever.
+        if (turns) len.add(track_length(k, kTurnQ29, widest).mul(turns));
+        len.div(18).shift(static_cast<int8_t>(-29 - scale));
+    }
+    if (k.bezier) {
+        out.min_radius_um =
+            k.rmin.m ? k.rmin.shift(static_cast<int8_t>(-scale)).u32() : 0xFFFFFFFFul;
+    } else {
+        k.e.dir[0][0] = k.e.dir[1][0];
+        k.e.dir[0][1] = k.e.dir[1][1];
+    }
+    tangent(k, out.end_dir);
+    if (len.m == 0) return false;
+    out.len_q8 = len.shift(8).u32();
+    return true;
 }
 
 } // namespace
 
 bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
-    const int32_t dw = w_regulated ? dw_um : 0;
-    Num len{};
-    if (cp.kind == kCurveArc) {
-        const uint32_t r[2] = {static_cast<uint32_t>(cp.b_um[0]),
-                               static_cast<uint32_t>(cp.b_um[1])};
-        if (r[0] == 0 || r[1] == 0) return false;
-        int32_t c0, s0, c1, s1;
-        ellipse_direction(cp.start_um[0] - cp.a_um[0], cp.start_um[1] - cp.a_um[1], r, c0, s0);
-        ellipse_direction(cp.end_um[0] - cp.a_um[0], cp.end_um[1] - cp.a_um[1], r, c1, s1);
-        int64_t sweep = arc_sweep_q29(c0, s0, c1, s1, cp.clockwise != 0, cp.turns);
-        uint64_t mag = static_cast<uint64_t>(sweep < 0 ? -sweep : sweep);
-        uint8_t sh = 0;
-        while ((mag >> sh) > 0xFFFFFFFFull) ++sh;
-        Num angle(static_cast<uint32_t>(mag >> sh), static_cast<int8_t>(sh - 29)); // radians
-        if (r[0] == r[1]) {
-            len = angle;
-            len.mul(r[0]); // r |sweep|, µm
-            out.min_radius_um = r[0];
-        } else {
-            // Simpson's rule on |dP/dt| = sqrt(ru^2 sin^2 t + rv^2 cos^2 t) over k intervals
-            // and k/2 from the same nodes, with k doubled (from 32 per turn) until both agree to
-            // 1e-5, then extrapolated (Richardson): an eccentric ellipse needs more nodes near
-            // the ends of its major axis. The unit vector advances by an integer rotation.
-            uint32_t k = static_cast<uint32_t>(mag / (2ull * kPiQ29 / 32)) + 1;
-            k = (k + 3) & ~3ul;
-            for (;;) {
-                int32_t h = static_cast<int32_t>(
-                    Num(static_cast<uint32_t>(mag >> 10)).div(k).shift(11).u32());
-                if (sweep < 0) h = -h;
-                int32_t rc, rs, arm;
-                small_angle_q30(h, rc, rs, arm);
-                int32_t c = c0, s = s0;
-                Num fine{}, coarse{};
-                for (uint32_t i = 0; i <= k; ++i) {
-                    Num a(r[0]), b(r[1]);
-                    a.mul(abs32(s)).shift(-30);
-                    b.mul(abs32(c)).shift(-30);
-                    Num aa = a, bb = b;
-                    Num f = aa.mul(a).add(bb.mul(b)).sqrt();
-                    simpson_add(fine, coarse, f, i, k);
-                    int32_t cn = mul_q30(c, rc) - mul_q30(s, rs);
-                    s = mul_q30(s, rc) + mul_q30(c, rs);
-                    c = cn;
-                }
-                len = simpson_richardson(fine, coarse, angle, k);
-                // converged when 2 coarse and fine (both k/2 weighted) agree: |S_k - S_k/2| < 1e-5
-                // S
-                Num f2 = fine, c2 = coarse;
-                c2.mul(2);
-                int8_t order = f2.cmp(c2);
-                Num lo_ = order < 0 ? f2 : c2, hi_ = order < 0 ? c2 : f2;
-                uint32_t ratio = lo_.div(hi_).shift(30).u32();
-                if ((1ul << 30) - ratio < 10737 || k >= 1024) break; // 1e-5 x 2^30
-                k *= 2;
-            }
-            uint32_t lo = r[0] < r[1] ? r[0] : r[1], hi = r[0] < r[1] ? r[1] : r[0];
-            out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // a^2 / b at the flat ends
-        }
-        int32_t tu, tv;
-        ellipse_tangent(r, c0, s0, cp.clockwise != 0, tu, tv);
-        // w rises linearly with the angle: dw / |sweep| µm per radian.
-        int32_t tw = static_cast<int32_t>(Num(abs32(dw_um)).div(angle).u32());
-        if (dw_um < 0) tw = -tw;
-        unit3(tu, tv, tw, out.start_dir);
-        ellipse_tangent(r, c1, s1, cp.clockwise != 0, tu, tv);
-        unit3(tu, tv, tw, out.end_dir);
-    } else {
-        const int32_t p[4][2] = {{cp.start_um[0], cp.start_um[1]},
-                                 {cp.a_um[0], cp.a_um[1]},
-                                 {cp.b_um[0], cp.b_um[1]},
-                                 {cp.end_um[0], cp.end_um[1]}};
-        // Simpson's rule on |B'(t)| over k and k/2 intervals, k doubled from 32 until both
-        // agree to 1e-5, extrapolated; the smallest radius of curvature |B'|^3 / |B' x B''|
-        // sampled at the same points (B'' from neighbouring slopes).
-        Num rmin{};
-        bool have_r = false;
-        for (uint32_t k = 32;; k *= 2) {
-            Num fine{}, coarse{};
-            int32_t prev[2] = {0, 0};
-            const uint8_t log_k = static_cast<uint8_t>(
-                k == 32 ? 5 : (k == 64 ? 6 : (k == 128 ? 7 : (k == 256 ? 8 : 9))));
-            for (uint32_t i = 0; i <= k; ++i) {
-                int32_t d[2];
-                bezier_slope(p, i << (20 - log_k), d);
-                simpson_add(fine, coarse, norm3(d[0], d[1], 0), i, k);
-                if (i != 0 && k == 32) {
-                    // |B' x dB'| / dt with dt = 1/32, |B'|^3 / that.
-                    int64_t cross =
-                        static_cast<int64_t>(prev[0]) * d[1] - static_cast<int64_t>(prev[1]) * d[0];
-                    Num n = norm3(d[0], d[1], 0);
-                    if (cross != 0 && n.m != 0) {
-                        uint64_t ac = static_cast<uint64_t>(cross < 0 ? -cross : cross);
-                        Num cr(static_cast<uint32_t>(ac >> 16), 16);
-                        Num rc = n;
-                        rc.mul(n).mul(n).div(cr).div(32);
-                        if (!have_r || rc.cmp(rmin) < 0) rmin = rc;
-                        have_r = true;
-                    }
-                }
-                prev[0] = d[0];
-                prev[1] = d[1];
-            }
-            len = simpson_richardson(fine, coarse, Num(1), k);
-            Num f2 = fine, c2 = coarse;
-            c2.mul(2);
-            int8_t order = f2.cmp(c2);
-            Num lo_ = order < 0 ? f2 : c2, hi_ = order < 0 ? c2 : f2;
-            uint32_t ratio = lo_.div(hi_).shift(30).u32();
-            if ((1ul << 30) - ratio < 10737 || k >= 512) break; // 1e-5 x 2^30
-        }
-        out.min_radius_um = have_r ? rmin.u32() : 0xFFFFFFFFul;
-        // Tangents: the first non-degenerate arm at each end; w rises linearly with t.
-        int32_t su = p[1][0] - p[0][0], sv = p[1][1] - p[0][1];
-        if (su == 0 && sv == 0) {
-            su = p[2][0] - p[0][0];
-            sv = p[2][1] - p[0][1];
-        }
-        int32_t eu = p[3][0] - p[2][0], ev = p[3][1] - p[2][1];
-        if (eu == 0 && ev == 0) {
-            eu = p[3][0] - p[1][0];
-            ev = p[3][1] - p[1][1];
-        }
-        // |B'(0)| = 3 |p1 - p0|: w' = dw per unit t, so compare with 3 x the arm.
-        unit3(3 * su, 3 * sv, dw_um, out.start_dir);
-        unit3(3 * eu, 3 * ev, dw_um, out.end_dir);
-    }
-    if (dw != 0) { // helix: sqrt(plane^2 + dw^2)
-        Num w(abs32(dw));
-        Num l2 = len;
-        len = l2.mul(len).add(w.mul(w)).sqrt();
-    }
-    if (len.m == 0) return false;
-    out.len_q8 = len.shift(8).u32();
-    return true;
+    Track k{};
+    out.start_dir[0] = out.start_dir[1] = out.start_dir[2] = 0;
+    out.end_dir[0] = out.end_dir[1] = out.end_dir[2] = 0;
+    return shape(cp, dw_um, w_regulated && dw_um != 0, out, k);
 }
 
 } // namespace ll

@@ -374,7 +374,7 @@ TEST(CurveShape, HelixLengthAddsTheRiseInQuadrature) {
     EXPECT_NEAR(sh.start_dir[2] / std::ldexp(1.0, 29), 5.0 / std::hypot(2 * kPi * 10, 5.0), 1e-4);
 }
 
-TEST(CurveShape, EllipseLengthComesFromAdaptiveSimpsonWithinTenToTheMinusFive) {
+TEST(CurveShape, EllipseLengthComesFromQuadratureWithinTenToTheMinusFive) {
     // Quarter of the ellipse 30 x 10 from (30, 0) to (0, 10), and a whole 50 x 5 one.
     ll::CurveShape sh;
     ASSERT_TRUE(ll::curve_shape(arc_params(30, 0, 0, 10, 0, 0, 30, 10, false), 0, true, sh));
@@ -421,6 +421,179 @@ TEST(CurveShape, BezierLengthAndCurvatureMatchNumericReferences) {
     std::printf("bezier: %.5f mm (exact %.5f), min radius %.3f mm (exact %.3f)\n",
                 sh.len_q8 / 256000.0, len, sh.min_radius_um / 1000.0, rmin);
     EXPECT_NEAR(sh.len_q8 / 256000.0 / len, 1.0, 1e-5);
-    // Sampled at 33 points, the smallest radius is found to within the sampling.
+    // Sampled at every quadrature node, the smallest radius is found to within the sampling.
     EXPECT_NEAR(sh.min_radius_um / 1000.0 / rmin, 1.0, 0.1);
+}
+
+namespace {
+
+double sq(double x) {
+    return x * x;
+}
+
+// Arc length of a parametric curve (x'(t), y'(t), w'(t)) by the midpoint rule on n points.
+template <class Speed>
+double numeric_length(const Speed& speed, double t0, double t1, int n) {
+    double s = 0, h = (t1 - t0) / n;
+    for (int i = 0; i < n; ++i) s += speed(t0 + (i + 0.5) * h);
+    return s * std::fabs(h);
+}
+
+} // namespace
+
+TEST(CurveShape, RandomEllipseArcsAndHelicesWithinTenToTheMinusFive) {
+    // Eccentricities up to 100:1, partial arcs, extra turns and helices: the panels follow
+    // |P'| / |P''|, so the tight ends of the major axis get narrow ones.
+    std::mt19937 rng(61);
+    std::uniform_real_distribution<double> ang(-kPi, kPi), frac(0, 1);
+    double worst = 0;
+    for (int i = 0; i < 300; ++i) {
+        double a = log_uniform(rng, 1, 200), b = a * log_uniform(rng, 0.01, 3);
+        double t0 = ang(rng), sweep = frac(rng) * 2 * kPi;
+        bool cw = (rng() & 1) != 0;
+        uint8_t turns = i % 10 == 0 ? 1 : 0;
+        double t1 = t0 + (cw ? -sweep : sweep);
+        double dw = i % 3 == 0 ? (frac(rng) - 0.5) * 100 : 0; // mm
+        ll::CurveParams p = arc_params(a * std::cos(t0), b * std::sin(t0), a * std::cos(t1),
+                                       b * std::sin(t1), 0, 0, a, b, cw, turns);
+        int32_t dw_um = static_cast<int32_t>(std::lround(dw * 1000));
+        ll::CurveShape sh;
+        ASSERT_TRUE(ll::curve_shape(p, dw_um, true, sh)) << i;
+        // The reference from the commanded (rounded) points, as the firmware sees them.
+        double ra = p.b_um[0] / 1000.0, rb = p.b_um[1] / 1000.0;
+        double u0 = std::atan2(p.start_um[1] / 1000.0 / rb, p.start_um[0] / 1000.0 / ra);
+        double u1 = std::atan2(p.end_um[1] / 1000.0 / rb, p.end_um[0] / 1000.0 / ra);
+        double d = cw ? u0 - u1 : u1 - u0;
+        while (d <= 0) d += 2 * kPi;
+        while (d > 2 * kPi) d -= 2 * kPi;
+        d += turns * 2 * kPi;
+        double rise = dw_um / 1000.0 / d;
+        double want = numeric_length(
+            [&](double t) {
+                return std::sqrt(sq(ra * std::sin(t)) + sq(rb * std::cos(t)) + sq(rise));
+            },
+            u0, u0 + (cw ? -d : d), 200000);
+        // Relative, beyond the unit of the length (1/256 µm, floored), which is all that is left
+        // on arcs of a few µm.
+        double err = std::max(0.0, std::fabs(sh.len_q8 / 256000.0 - want) - 1 / 256000.0) / want;
+        worst = std::max(worst, err);
+        ASSERT_LT(err, 1e-5) << i << ": " << a << " x " << b << " mm, sweep " << d;
+    }
+    std::printf("300 ellipse arcs: worst relative length error %.1e\n", worst);
+}
+
+TEST(CurveShape, RandomBeziersAndTheirHelicesWithinTenToTheMinusFive) {
+    std::mt19937 rng(62);
+    std::uniform_real_distribution<double> u(-1, 1), frac(0, 1);
+    double worst = 0, rmin_low = 1e300, rmin_high = 0;
+    for (int i = 0; i < 300; ++i) {
+        double scale = log_uniform(rng, 1, 300); // mm
+        ll::CurveParams p{};
+        p.kind = ll::kCurveBezier;
+        int32_t* pts[4] = {p.start_um, p.a_um, p.b_um, p.end_um};
+        double q[4][2];
+        for (int k = 0; k < 4; ++k) {
+            for (int j = 0; j < 2; ++j) {
+                pts[k][j] = static_cast<int32_t>(std::lround(u(rng) * scale * 1000));
+                q[k][j] = pts[k][j] / 1000.0;
+            }
+        }
+        double dw = i % 3 == 0 ? (frac(rng) - 0.5) * 100 : 0; // mm
+        int32_t dw_um = static_cast<int32_t>(std::lround(dw * 1000));
+        ll::CurveShape sh;
+        ASSERT_TRUE(ll::curve_shape(p, dw_um, true, sh)) << i;
+        auto d1 = [&](double t, int k) {
+            double s = 1 - t;
+            return 3 * s * s * (q[1][k] - q[0][k]) + 6 * s * t * (q[2][k] - q[1][k]) +
+                   3 * t * t * (q[3][k] - q[2][k]);
+        };
+        auto d2 = [&](double t, int k) {
+            return 6 * (1 - t) * (q[2][k] - 2 * q[1][k] + q[0][k]) +
+                   6 * t * (q[3][k] - 2 * q[2][k] + q[1][k]);
+        };
+        double want = numeric_length(
+            [&](double t) { return std::sqrt(sq(d1(t, 0)) + sq(d1(t, 1)) + sq(dw_um / 1000.0)); },
+            0, 1, 200000);
+        double err = std::max(0.0, std::fabs(sh.len_q8 / 256000.0 - want) - 1 / 256000.0) / want;
+        worst = std::max(worst, err);
+        ASSERT_LT(err, 1e-5) << i << ": scale " << scale << " mm";
+        // The smallest radius is the smallest of the radii at the sample points: never below
+        // the true one (to the µm it is floored to), and within 10% of it where it is over
+        // 10 µm (the samples crowd where the curve turns tightly).
+        double rmin = 1e300;
+        for (int j = 0; j <= 20000; ++j) {
+            double t = j / 20000.0;
+            double x = d1(t, 0), y = d1(t, 1);
+            double cross = std::fabs(x * d2(t, 1) - y * d2(t, 0));
+            if (cross > 0) rmin = std::min(rmin, std::pow(std::hypot(x, y), 3) / cross);
+        }
+        EXPECT_GT((sh.min_radius_um + 1) / 1000.0, rmin * (1 - 1e-3)) << i;
+        if (rmin < 0.01) continue;
+        double ratio = sh.min_radius_um / 1000.0 / rmin;
+        EXPECT_NEAR(ratio, 1.0, 0.1) << i << ": smallest radius " << rmin << " mm";
+        rmin_low = std::min(rmin_low, ratio);
+        rmin_high = std::max(rmin_high, ratio);
+    }
+    std::printf("300 Beziers: worst relative length error %.1e, smallest radius (over 10 µm) "
+                "found %.3f .. %.3f x the true one\n",
+                worst, rmin_low, rmin_high);
+}
+
+TEST(CurveShape, NullEndArmsTakeTheDirectionOfTheNextArm) {
+    // p1 = p0 and p2 = p3: the curve leaves along p2 - p0 and arrives along p3 - p1.
+    ll::CurveParams p{};
+    p.kind = ll::kCurveBezier;
+    p.start_um[0] = 0;
+    p.start_um[1] = 0;
+    p.a_um[0] = 0;
+    p.a_um[1] = 0;
+    p.b_um[0] = 30000;
+    p.b_um[1] = 40000;
+    p.end_um[0] = 30000;
+    p.end_um[1] = 40000;
+    ll::CurveShape sh;
+    ASSERT_TRUE(ll::curve_shape(p, 0, true, sh));
+    const double q = std::ldexp(1.0, 29);
+    EXPECT_NEAR(sh.start_dir[0] / q, 0.6, 1e-4);
+    EXPECT_NEAR(sh.start_dir[1] / q, 0.8, 1e-4);
+    EXPECT_NEAR(sh.end_dir[0] / q, 0.6, 1e-4);
+    EXPECT_NEAR(sh.end_dir[1] / q, 0.8, 1e-4);
+    EXPECT_EQ(sh.start_dir[2], 0);
+    // A general one: p1 = p0, the start along p2 - p0.
+    p.b_um[0] = 10000;
+    p.b_um[1] = -20000;
+    p.end_um[0] = 40000;
+    p.end_um[1] = 10000;
+    ASSERT_TRUE(ll::curve_shape(p, 0, true, sh));
+    EXPECT_NEAR(sh.start_dir[0] / q, 1 / std::sqrt(5.0), 1e-3);
+    EXPECT_NEAR(sh.start_dir[1] / q, -2 / std::sqrt(5.0), 1e-3);
+}
+
+TEST(CurveShape, BezierWithACuspHasItsLength) {
+    // (0,0) (10,10) (0,10) (10,0) mm: B'(1/2) = 0, a cusp, where |B'| has a kink; the panels
+    // narrow towards it from both sides.
+    ll::CurveParams p{};
+    p.kind = ll::kCurveBezier;
+    p.a_um[0] = 10000;
+    p.a_um[1] = 10000;
+    p.b_um[0] = 0;
+    p.b_um[1] = 10000;
+    p.end_um[0] = 10000;
+    ll::CurveShape sh;
+    ASSERT_TRUE(ll::curve_shape(p, 0, true, sh));
+    double q[4][2] = {{0, 0}, {10, 10}, {0, 10}, {10, 0}};
+    double want = 0;
+    const int n = 400000;
+    for (int i = 0; i < n; ++i) {
+        double t = (i + 0.5) / n, s = 1 - t, d[2];
+        for (int k = 0; k < 2; ++k) {
+            d[k] = 3 * s * s * (q[1][k] - q[0][k]) + 6 * s * t * (q[2][k] - q[1][k]) +
+                   3 * t * t * (q[3][k] - q[2][k]);
+        }
+        want += std::hypot(d[0], d[1]) / n;
+    }
+    std::printf("cusp: %.6f mm, exact %.6f mm, smallest radius %u µm\n", sh.len_q8 / 256000.0, want,
+                sh.min_radius_um);
+    EXPECT_NEAR(sh.len_q8 / 256000.0 / want, 1.0, 1e-5);
+    EXPECT_LT(sh.min_radius_um, 10u); // at the cusp, 0
 }

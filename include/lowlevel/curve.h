@@ -11,11 +11,11 @@
 // and since N is a power of two the differences are set up with shifts.
 //
 // Arcs and ellipses (X = cu + ru cos t, Y = cv + rv sin t, docs/curves.md): pieces of at most
-// 22.5 degrees (and 2000 ticks), each the cubic whose arms are 4/3 tan(h/4) long, which stays
+// 21.5 degrees (and 2000 ticks), each the cubic whose arms are 4/3 tan(h/4) long, which stays
 // within 7e-8 radius of the true curve; the unit vector (cos t, sin t) is advanced from piece to
 // piece by an integer rotation whose sine and cosine come from their series where the arc is
 // prepared. Beziers are cut into 2^j pieces of equal parameter length, each exactly the
-// corresponding part of the curve (its ends and tangents evaluated by Horner's rule).
+// corresponding part of the curve (its ends and tangents by de Casteljau's algorithm).
 #pragma once
 
 #include "lowlevel/config.h"
@@ -57,8 +57,12 @@ struct CurveShape {
 
 /// Length, curvature and end tangents of a curve whose normal axis travels `dw_um`
 /// (`w_regulated`: w counts in the path length). Returns false for a degenerate curve.
-/// Circles and helices in closed form; ellipses and Beziers by Simpson's rule over 32
-/// intervals per turn / per curve (docs/curves.md: no closed form exists for an ellipse).
+/// Circles and circular helices in closed form. Ellipses and Beziers (and their helices) by
+/// Gauss-Legendre quadrature of the speed, 3 nodes per panel, each panel at most half the local
+/// scale |P'| / |P''| wide: panels shrink where the curve turns tightly (the ends of an
+/// eccentric ellipse's major axis, near-cusps), so the length is good to 1e-6 relative
+/// (docs/curves.md: no closed form exists for an ellipse). The smallest radius of curvature of a
+/// Bezier is the smallest |B'|^3 / |B' x B''| at the panel ends, which crowd where it is small.
 bool curve_shape(const CurveParams& c, int32_t dw_um, bool w_regulated, CurveShape& out);
 
 /// Direction of the point (x, y) seen from an ellipse's centre, normalised in the ellipse's
@@ -106,35 +110,37 @@ class CurveWalker {
     int32_t pos[3]; ///< current position, ticks (u, v, w)
 
   private:
+    void begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind);
     bool next_piece();
-    void start_piece(const int32_t p0[3], const int32_t p1[3], const int32_t p2[3],
-                     const int32_t p3[3]);
-    void arc_point(int32_t c, int32_t s, int32_t out[2]) const;
-    void bezier_point(uint32_t a_q20, int32_t out[2], int32_t slope[2]) const;
+    void start_piece(const int32_t p3[3], const int32_t arm0[3], const int32_t arm3[3]);
+    void arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const;
+    void bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const;
 
-    // Current piece: forward differences, Q40 ticks relative to base_.
-    int64_t f_[3], d1_[3], d2_[3], d3_[3];
+    // Current piece, per axis: the position and its forward differences (f, d1, d2, d3), Q40
+    // ticks relative to base_.
+    int64_t fd_[3][4];
     int32_t base_[3];
     uint16_t left_;
     // Curve
     uint8_t kind_;          ///< 0 done, 1 arc, 2 bezier
+    uint8_t axes_;          ///< axes walked: 2 (u, v), or 3 when w moves (a helix)
     uint16_t pieces_;       ///< pieces not started yet
     uint16_t piece_count_;  ///< pieces in the curve
     int32_t end_[3];        ///< final position, ticks
     int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
     int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
-    int32_t end_c_, end_s_; ///< arc: direction of the end point; Bezier: the end (ticks x 256)
     uint8_t log_pieces_;    ///< Bezier: 2^j pieces
     // An arc or a Bezier, never both.
     struct ArcState {
         int32_t centre[2];
         uint32_t radii[2];
-        int32_t c, s, rot_c, rot_s, arm; ///< unit vector of the next piece's start, rotation
-                                         ///< per piece and arm length, Q30
+        int32_t dir[2][2]; ///< (cos t, sin t) of the next piece's start and of the end, Q30
+        int32_t rot[2];    ///< cosine and sine of the piece angle h, Q30
+        int32_t arm;       ///< 4 tan(h/4): 3 x a piece's arm per unit of radius, Q30
     };
     union {
         ArcState a_;
-        int64_t poly_[4][2]; ///< Bezier: B(a) = c0 + c1 a + c2 a^2 + c3 a^3, ticks x 256
+        int32_t pts_[2][4]; ///< Bezier: control points, u then v, ticks x 256
     };
 };
 
