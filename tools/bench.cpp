@@ -424,11 +424,16 @@ struct CircleRun {
     double window = 0;              ///< cycles from the first line sent to the last step
 };
 
-CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool profile) {
+/// The circle of 0.1 mm segments, or with `native` the same circle as one G3 (centre at -r on
+/// X from the start, counter-clockwise, as the segments go).
+CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool profile,
+                     bool native = false) {
     CircleRun c;
     Board b(cfg.elf);
     b.settings({"$100=80", "$101=80", "$110=5000", "$111=5000", "$120=1000", "$121=1000"});
-    const std::vector<std::string> job = circle_job(radius, 0.1, circle_feed());
+    const std::vector<std::string> job =
+        native ? std::vector<std::string>{fmt("G3X0Y0I%gJ0F%.0f", -radius, circle_feed())}
+               : circle_job(radius, 0.1, circle_feed());
     c.lines = job.size();
     std::unique_ptr<Profiler> prof;
     const std::string kExecute = "_ZN2ll5gcode7executeEPKchRNS0_7OutcomeE";
@@ -847,6 +852,16 @@ int main(int argc, char** argv) {
             print_circle("send-and-wait:", cs, ideal);
             rows.push_back({"Circle, send-and-wait", circle_figure(cs), "—", "2.38 s", "—"});
         }
+        // The same circle as one G3, stepped natively (docs/curves.md): no segments to stream.
+        const CircleRun cn = circle_run(cfg, radius, false, false, true);
+        print_circle("one G3:", cn, ideal);
+        rows.push_back({"Circle r10 as one G3 (native curve)", circle_figure(cn),
+                        "≤ 1.44 s (1.1x ideal 1.3066 s)", "— (GRBL cuts arcs into segments)",
+                        circle_met(cn)});
+        rows.push_back({"Circle as one G3: worst deviation from the true circle",
+                        cn.errors < 0 ? "—" : fmt("%.2f ticks", cn.worst_dev), "≤ 1.0 tick",
+                        "1.235 ticks (from the issue)",
+                        cn.errors == 0 && cn.worst_dev <= 1.0 ? "yes" : "no"});
     }
 
     if (cfg.want("size")) {
