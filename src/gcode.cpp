@@ -334,27 +334,28 @@ void set_end_modes(Modal& m) {
     m.coolant = 9;
 }
 
-// sqrt(x^2 + y^2) for um values.
-Num hypot_um(int32_t x, int32_t y) {
-    Num a(abs32(x)), b(abs32(y));
-    Num aa = a, bb = b;
-    return aa.mul(a).add(bb.mul(b)).sqrt();
+// p - q for two points of the plane (an overflow flags the block, as add() does).
+__attribute__((noinline)) void sub2(int32_t out[2], const int32_t p[2], const int32_t q[2]) {
+    for (uint8_t k = 0; k < 2; ++k) out[k] = add(p[k], q[k], true);
 }
 
-// |Num a - Num b| on a fixed-point scale: both are below 2^31 here (um lengths).
-uint32_t diff_um(const Num& a, const Num& b) {
-    uint32_t x = a.u32(), y = b.u32();
-    return x > y ? x - y : y - x;
+// |p - q| for two points of the plane, um.
+__attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
+    int32_t d[2];
+    sub2(d, p, q);
+    uint32_t v[2] = {abs32(d[0]), abs32(d[1])};
+    return sum_squares(v, 2).sqrt();
 }
 
-// How far (um, the larger of the two coordinates) (x, y) is from the point of the ellipse of
-// semi-axes `radii` centred on the origin that has the same direction in the ellipse's own scale
-// (ellipse_direction): within a tick of it is on the ellipse. (A point so far out that the
+// How far (um, the larger of the two coordinates) the point p is from the point of the ellipse
+// of semi-axes `radii` centred on `centre` that has the same direction in the ellipse's own
+// scale (ellipse_direction): within a tick of it is on the ellipse. (A point so far out that the
 // difference wraps is refused by the range check anyway.)
-uint32_t ellipse_gap_um(int32_t x, int32_t y, const uint32_t radii[2]) {
-    int32_t cs[2];
-    ellipse_direction(x, y, radii, cs[0], cs[1]);
-    const int32_t xy[2] = {x, y};
+__attribute__((noinline)) uint32_t ellipse_gap_um(const int32_t p[2], const int32_t centre[2],
+                                                  const uint32_t radii[2]) {
+    int32_t xy[2], cs[2];
+    sub2(xy, p, centre);
+    ellipse_direction(xy[0], xy[1], radii, cs[0], cs[1]);
     uint32_t gap = 0;
     for (uint8_t k = 0; k < 2; ++k) {
         uint32_t on = Num(radii[k]).mul(abs32(cs[k])).shift(-30).u32();
@@ -363,15 +364,6 @@ uint32_t ellipse_gap_um(int32_t x, int32_t y, const uint32_t radii[2]) {
         if (d > gap) gap = d;
     }
     return gap;
-}
-
-// A length word of the block (um), or `dflt` when absent; false on overflow.
-bool word_um(const Block& b, uint8_t word, int32_t dflt, int32_t& out) {
-    if (!(b.words & bit(word))) {
-        out = dflt;
-        return true;
-    }
-    return length(b, b.v[word].d, out);
 }
 
 // The step generator's fixed-point range (docs/curves.md): the ends, the control points or the
@@ -423,106 +415,108 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     const uint8_t in_plane = static_cast<uint8_t>((1u << u) | (1u << v));
     // A curve moves the plane's axes and, along a helix, the normal one: not the others.
     if (axes & ~(in_plane | (1u << ax[2]))) return kAxisWordsExist;
-    const WordMask wi = bit(static_cast<uint8_t>(kWordI + u)),
-                   wj = bit(static_cast<uint8_t>(kWordI + v));
     bool ellipse = motion == Motion::EllipseCw || motion == Motion::EllipseCcw;
+    bool bezier = motion == Motion::Bezier;
     if (!ellipse && axes == 0) return kNoAxisWords;
-    if (!ellipse && motion != Motion::Bezier && !(axes & in_plane)) return kNoAxisWordsInPlane;
-    c.kind = motion == Motion::Bezier ? kCurveBezier : kCurveArc;
+    if (!ellipse && !bezier && !(axes & in_plane)) return kNoAxisWordsInPlane;
+    c.kind = bezier ? kCurveBezier : kCurveArc;
     c.clockwise = motion == Motion::ArcCw || motion == Motion::EllipseCw;
     c.turns = 0;
-    c.start_um[0] = st.position[u];
-    c.start_um[1] = st.position[v];
-    c.end_um[0] = w.req.target_um[u];
-    c.end_um[1] = w.req.target_um[v];
-    int32_t x = add(c.end_um[0], c.start_um[0], true), y = add(c.end_um[1], c.start_um[1], true);
-    int32_t ou, ov, pw, qw;
-    if (!word_um(b, static_cast<uint8_t>(kWordI + u), 0, ou) ||
-        !word_um(b, static_cast<uint8_t>(kWordI + v), 0, ov) || !word_um(b, kWordP, 0, pw) ||
-        !word_um(b, kWordQ, 0, qw)) {
-        return kBadNumberFormat;
+    // o: the plane's offsets (I J, I K or J K), then P and Q, in um.
+    int32_t o[4];
+    const uint8_t words[4] = {static_cast<uint8_t>(kWordI + u), static_cast<uint8_t>(kWordI + v),
+                              kWordP, kWordQ};
+    for (uint8_t k = 0; k < 4; ++k) {
+        o[k] = 0;
+        if ((b.words & bit(words[k])) && !length(b, b.v[words[k]].d, o[k])) {
+            return kBadNumberFormat;
+        }
+        if (k < 2) {
+            c.start_um[k] = st.position[ax[k]];
+            c.end_um[k] = w.req.target_um[ax[k]];
+        }
     }
-    bool has_offsets = (b.words & (wi | wj)) != 0;
+    int32_t d[2]; // end - start
+    sub2(d, c.end_um, c.start_um);
+    bool has_offsets = (b.words & (bit(words[0]) | bit(words[1]))) != 0;
     bool has_pq = (b.words & bit(kWordP)) && (b.words & bit(kWordQ));
     const WordMask ijk = bit(kWordI) | bit(kWordJ) | bit(kWordK);
     WordMask used = static_cast<WordMask>(ijk | bit(kWordP) | bit(kWordQ)); // G2.1, G3.1, G5
-    if (motion == Motion::Bezier) {
+    uint32_t r = 0;
+    if (bezier) {
         // G5 (Marlin): I J the first control point from the start (or, after a G5, the
         // reflection of its second one), P Q the second control point from the end.
         if (!has_pq) return kValueWordMissing;
         if (!has_offsets) {
             if (!st.g5_continues) return kValueWordMissing;
-            ou = st.g5_reflect[0];
-            ov = st.g5_reflect[1];
+            o[0] = st.g5_reflect[0];
+            o[1] = st.g5_reflect[1];
         }
-        c.a_um[0] = add(c.start_um[0], ou);
-        c.a_um[1] = add(c.start_um[1], ov);
-        c.b_um[0] = add(c.end_um[0], pw);
-        c.b_um[1] = add(c.end_um[1], qw);
     } else if (ellipse) {
         // G2.1 / G3.1: I J the centre from the start, P Q the semi-axes along the plane's
-        // axes; both ends on the ellipse within one tick + 0.002 mm.
+        // axes; both ends on the ellipse within one tick + 0.002 mm (checked below).
         if (!has_offsets) return kNoOffsetsInPlane;
         if (!has_pq) return kValueWordMissing;
-        if (pw <= 0 || qw <= 0) return kNegativeValue;
-        c.a_um[0] = add(c.start_um[0], ou);
-        c.a_um[1] = add(c.start_um[1], ov);
-        c.b_um[0] = pw;
-        c.b_um[1] = qw;
-        const uint32_t radii[2] = {static_cast<uint32_t>(pw), static_cast<uint32_t>(qw)};
-        uint32_t tol = 0;
-        for (uint8_t k = 0; k < 2; ++k) {
-            uint32_t t = 1000000ul / g_settings.axis[ax[k]].steps_per_unit + 2; // a step + 2 um
-            if (t > tol) tol = t;
-        }
-        if (ellipse_gap_um(-ou, -ov, radii) > tol ||
-            ellipse_gap_um(add(c.end_um[0], c.a_um[0], true), add(c.end_um[1], c.a_um[1], true),
-                           radii) > tol) {
-            return kInvalidTarget;
-        }
+        if (o[2] <= 0 || o[3] <= 0) return kNegativeValue;
     } else {
         // G2 / G3, as GRBL: radius mode (R) or centre mode (the plane's offsets).
-        int32_t i, j;
-        uint32_t r;
         used = bit(kWordP);
         if (b.words & bit(kWordR)) {
             used = static_cast<WordMask>(used | bit(kWordR)); // I J K stay unused (GRBL: 36)
             int32_t rw;
             if (!length(b, b.v[kWordR].d, rw)) return kBadNumberFormat;
-            if (x == 0 && y == 0) return kInvalidTarget;
+            if (d[0] == 0 && d[1] == 0) return kInvalidTarget;
             // Centre on the perpendicular bisector: h = -sqrt(4 r^2 - d^2) / d, negated for
             // G3 and for a negative R (the longer arc).
-            Num d = hypot_um(x, y);
-            Num r2(abs32(rw));
+            r = abs32(rw);
+            const int32_t zero[2] = {0, 0};
+            Num dn = dist_um(d, zero);
+            Num r2(r);
             r2.mul(r2).mul(4u);
-            Num d2 = d;
-            d2.mul(d);
+            Num d2 = dn;
+            d2.mul(dn);
             if (r2.cmp(d2) < 0) return kArcRadiusError;
             uint32_t rr = r2.shift(-16).u32(), dd = d2.shift(-16).u32(); // both below 2^32
             Num h(rr - dd, 16);
-            h.sqrt().div(d);                                      // |h|
+            h.sqrt().div(dn);                                     // |h|
             bool neg = !((motion == Motion::ArcCcw) != (rw < 0)); // -sqrt(..), flipped
-            int32_t hy = static_cast<int32_t>(h.of(abs32(y))),
-                    hx = static_cast<int32_t>(h.of(abs32(x)));
-            if ((y < 0) != neg) hy = -hy;
-            if ((x < 0) != neg) hx = -hx;
-            i = (x - hy) / 2; // (x - y h) / 2
-            j = (y + hx) / 2; // (y + x h) / 2
-            r = abs32(rw);
+            // o = (d - h (d1, -d0)) / 2: (x - y h) / 2, (y + x h) / 2.
+            for (uint8_t k = 0; k < 2; ++k) {
+                int32_t t = static_cast<int32_t>(h.of(abs32(d[1 - k])));
+                if ((d[1 - k] < 0) != neg) t = -t;
+                o[k] = (k == 0 ? d[0] - t : d[1] + t) / 2;
+            }
+        } else if (!has_offsets) {
+            return kNoOffsetsInPlane;
         } else {
-            if (!has_offsets) return kNoOffsetsInPlane;
             used = static_cast<WordMask>(used | ijk);
-            i = ou;
-            j = ov;
-            Num rn = hypot_um(i, j);
-            r = rn.u32();
+        }
+    }
+    for (uint8_t k = 0; k < 2; ++k) {
+        c.a_um[k] = add(c.start_um[k], o[k]);
+        c.b_um[k] = bezier ? add(c.end_um[k], o[k + 2]) : o[k + 2];
+    }
+    if (ellipse) {
+        const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
+        uint32_t tol = 0;
+        for (uint8_t k = 0; k < 2; ++k) {
+            uint32_t t = 1000000ul / g_settings.axis[ax[k]].steps_per_unit + 2; // a step + 2 um
+            if (t > tol) tol = t;
+        }
+        if (ellipse_gap_um(c.start_um, c.a_um, radii) > tol ||
+            ellipse_gap_um(c.end_um, c.a_um, radii) > tol) {
+            return kInvalidTarget;
+        }
+    } else if (!bezier) {
+        if (!(b.words & bit(kWordR))) {
             // The end must be on the circle: within 0.005 mm, or else within 0.5 mm and 0.1 %.
-            uint32_t delta = diff_um(hypot_um(add(x, i, true), add(y, j, true)), rn);
+            Num rn = dist_um(c.start_um, c.a_um);
+            r = rn.u32();
+            Num re = dist_um(c.end_um, c.a_um);
+            uint32_t x = re.u32(), delta = x > r ? x - r : r - x;
             if (delta > 5 && (delta > 500 || delta > r / 1000)) return kInvalidTarget;
         }
         if (r == 0) return kInvalidTarget;
-        c.a_um[0] = add(c.start_um[0], i);
-        c.a_um[1] = add(c.start_um[1], j);
         c.b_um[0] = static_cast<int32_t>(r);
         c.b_um[1] = static_cast<int32_t>(r);
         if (b.words & bit(kWordP)) { // LinuxCNC: P turns, P1 the plain arc
