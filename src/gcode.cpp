@@ -297,8 +297,8 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
 }
 
 // A length word in the units of the block, to um (or a feed to mm/min x1000).
-bool length(const Block& b, const num::Decimal& d, int32_t& out) {
-    return num::length_to_milli(d, b.g[kGroupUnits] != 0, out);
+__attribute__((noinline)) bool length(const num::Decimal& d, int32_t& out) {
+    return num::length_to_milli(d, w.b.g[kGroupUnits] != 0, out);
 }
 
 // a + b, or a - b with `subtract`; an overflow sets Block::overflow (checked once per line:
@@ -372,10 +372,10 @@ __attribute__((noinline)) uint32_t ellipse_gap_um(const int32_t p[2], const int3
 // normal axis' travel `dw_um` too. (A function of its own: a small stack frame.)
 __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_t ax[3],
                                               int32_t dw_um) {
-    Num reach{}; // length bound, um
-    for (uint8_t k = 0; k < 2; ++k) {
-        const int32_t* const pts[4] = {c.start_um, c.end_um, c.a_um, c.b_um};
-        for (uint8_t i = 0; i < 4; ++i) {
+    Num reach{};                                                          // length bound, um
+    const int32_t* const pts[4] = {c.start_um, c.a_um, c.b_um, c.end_um}; // a G5's polygon
+    for (uint8_t i = 0; i < 4; ++i) {
+        for (uint8_t k = 0; k < 2; ++k) {
             int32_t steps;
             if (!num::mul_div_round(pts[i][k], g_settings.axis[ax[k]].steps_per_unit, 1000000u,
                                     steps) ||
@@ -383,19 +383,21 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
                 return false;
             }
         }
-        if (c.kind == kCurveBezier) {
-            reach.add(Num(abs32(c.a_um[k] - c.start_um[k])))
-                .add(Num(abs32(c.b_um[k] - c.a_um[k])))
-                .add(Num(abs32(c.end_um[k] - c.b_um[k])));
+        if (i != 0 && c.kind == kCurveBezier) {
+            int32_t d[2];
+            sub2(d, pts[i], pts[i - 1]);
+            reach.add(Num(abs32(d[0]))).add(Num(abs32(d[1])));
         }
     }
     if (c.kind == kCurveArc) {
-        const uint32_t radii[2] = {static_cast<uint32_t>(c.b_um[0]),
-                                   static_cast<uint32_t>(c.b_um[1])};
-        int32_t c0, s0, c1, s1;
-        ellipse_direction(c.start_um[0] - c.a_um[0], c.start_um[1] - c.a_um[1], radii, c0, s0);
-        ellipse_direction(c.end_um[0] - c.a_um[0], c.end_um[1] - c.a_um[1], radii, c1, s1);
-        int64_t sweep = arc_sweep_q29(c0, s0, c1, s1, c.clockwise != 0, c.turns);
+        const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
+        int32_t cs[4];
+        for (uint8_t e = 0; e < 2; ++e) {
+            int32_t p[2];
+            sub2(p, e ? c.end_um : c.start_um, c.a_um);
+            ellipse_direction(p[0], p[1], radii, cs[2 * e], cs[2 * e + 1]);
+        }
+        int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], c.clockwise != 0, c.turns);
         // |sweep| < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r |sweep|.
         uint32_t q21 = static_cast<uint32_t>((sweep < 0 ? -sweep : sweep) >> 8);
         reach.set(radii[0] > radii[1] ? radii[0] : radii[1]).mul(Num(q21, -21));
@@ -428,7 +430,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
                               kWordP, kWordQ};
     for (uint8_t k = 0; k < 4; ++k) {
         o[k] = 0;
-        if ((b.words & bit(words[k])) && !length(b, b.v[words[k]].d, o[k])) {
+        if ((b.words & bit(words[k])) && !length(b.v[words[k]].d, o[k])) {
             return kBadNumberFormat;
         }
         if (k < 2) {
@@ -464,7 +466,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         if (b.words & bit(kWordR)) {
             used = static_cast<WordMask>(used | bit(kWordR)); // I J K stay unused (GRBL: 36)
             int32_t rw;
-            if (!length(b, b.v[kWordR].d, rw)) return kBadNumberFormat;
+            if (!length(b.v[kWordR].d, rw)) return kBadNumberFormat;
             if (d[0] == 0 && d[1] == 0) return kInvalidTarget;
             // Centre on the perpendicular bisector: h = -sqrt(4 r^2 - d^2) / d, negated for
             // G3 and for a negative R (the longer arc).
@@ -498,11 +500,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     }
     if (ellipse) {
         const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
-        uint32_t tol = 0;
-        for (uint8_t k = 0; k < 2; ++k) {
-            uint32_t t = 1000000ul / g_settings.axis[ax[k]].steps_per_unit + 2; // a step + 2 um
-            if (t > tol) tol = t;
-        }
+        uint32_t spu = g_settings.axis[u].steps_per_unit, spv = g_settings.axis[v].steps_per_unit;
+        uint32_t tol = 1000000ul / (spu < spv ? spu : spv) + 2; // the larger step + 2 um
         if (ellipse_gap_um(c.start_um, c.a_um, radii) > tol ||
             ellipse_gap_um(c.end_um, c.a_um, radii) > tol) {
             return kInvalidTarget;
@@ -598,7 +597,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
     if (b.words & bit(kWordF)) {
         int32_t f;
-        if (!length(b, b.v[kWordF].d, f)) return kBadNumberFormat;
+        if (!length(b.v[kWordF].d, f)) return kBadNumberFormat;
         b.feed = static_cast<uint32_t>(f);
     }
 
@@ -617,7 +616,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
         if (!(m & 1)) continue;
         int32_t um;
-        if (!length(b, b.v[a].d, um)) return kBadNumberFormat;
+        if (!length(b.v[a].d, um)) return kBadNumberFormat;
         b.v[a].um = um;
     }
     // One pass over the axes computes either the new offsets (G10, G92) or the target of a
@@ -742,7 +741,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         // A G5 without I J continues the last G5 smoothly: remember its second arm.
         st.g5_continues = motion == Motion::Bezier;
         if (st.g5_continues) {
-            for (uint8_t k = 0; k < 2; ++k) st.g5_reflect[k] = w.curve.end_um[k] - w.curve.b_um[k];
+            sub2(st.g5_reflect, w.curve.end_um, w.curve.b_um);
         }
         copy_words(st.position, req.target_um, kAxes);
         copy_words(st.position_steps, req.target_steps, kAxes);
