@@ -45,7 +45,7 @@ inline uint32_t add_sat(uint32_t a, uint32_t b) {
 }
 
 /// |v| as an unsigned value (also for INT32_MIN).
-inline uint32_t abs32(int32_t v) {
+__attribute__((noinline)) inline uint32_t abs32(int32_t v) {
     return v < 0 ? static_cast<uint32_t>(-(v + 1)) + 1u : static_cast<uint32_t>(v);
 }
 
@@ -87,7 +87,7 @@ struct Num {
     Num& div(uint32_t v);   ///< v != 0
     Num& add(const Num& o);
     Num& sqrt();
-    Num& shift(int8_t k) {
+    __attribute__((noinline)) Num& shift(int8_t k) {
         if (m) e = static_cast<int8_t>(e + k);
         return *this;
     }
