@@ -202,8 +202,16 @@ struct Block {
     uint32_t feed;
     uint32_t s;
     uint32_t n;
-    Slot v[kDecimalSlots]; // the axes, F, P
+    union {
+        Slot v[kDecimalSlots]; // the axes, F, P, I J K Q R
+        // Stage 3 and 4 of a curve, handed to the planner with the move: written once the axes
+        // and F are in um (stage 3 [19]) and check_curve() has read P I J K Q R, so that it
+        // only overlays the slots of the axes and F (40 bytes of RAM less).
+        CurveParams curve;
+    };
 };
+static_assert(sizeof(CurveParams) <= kWordP * sizeof(Slot),
+              "the curve overlays the axis and F slots only");
 static_assert(offsetof(Block, n) - offsetof(Block, feed) ==
                   offsetof(State, line_number) - offsetof(State, feed),
               "feed, S and N are laid out as in State");
@@ -219,7 +227,6 @@ struct Work {
         // block never moves).
         motion::LineRequest req;
     };
-    CurveParams curve; // stage 3 and 4 of a curve: handed to the planner with req
 };
 Work w;
 
@@ -692,7 +699,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     } else if (b.axis_command == kAxisMotion) {
         if (motion != Motion::Seek && b.feed == 0) return kUndefinedFeedRate;
         if (motion >= Motion::ArcCw && motion <= Motion::Bezier) {
-            uint8_t r = check_curve(b, motion, axes, st, w.curve);
+            uint8_t r = check_curve(b, motion, axes, st, b.curve);
             if (r != kOk) return r;
             curve = true;
         } else if (axes == 0) {
@@ -736,12 +743,12 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     if (moves) {
         req.feed = b.feed;
         req.rapid = motion == Motion::Seek;
-        req.curve = curve ? &w.curve : nullptr;
+        req.curve = curve ? &b.curve : nullptr;
         if (!check) outcome.move = &req; // queued by the caller; the length was checked above
         // A G5 without I J continues the last G5 smoothly: remember its second arm.
         st.g5_continues = motion == Motion::Bezier;
         if (st.g5_continues) {
-            sub2(st.g5_reflect, w.curve.end_um, w.curve.b_um);
+            sub2(st.g5_reflect, b.curve.end_um, b.curve.b_um);
         }
         copy_words(st.position, req.target_um, kAxes);
         copy_words(st.position_steps, req.target_steps, kAxes);
