@@ -268,6 +268,11 @@ void dispatch() {
         if (r == kOkThenReset) soft_reset();
     } else if (p.alarm) {
         finish(kGcodeLock);
+    } else if (!motion::can_accept()) {
+        // The planner is full: parse the line once it has room rather than now and again then
+        // (the parse is a third of a short line's cost, and a streaming sender keeps the
+        // planner full). A line that would not move waits for that room too.
+        p.wait = Wait::WhenAccepting;
     } else {
         run_gcode();
     }

@@ -307,3 +307,17 @@ TEST_F(Protocol, RealTimeBytesInsideALineDoNotBreakIt) {
     EXPECT_EQ(out.substr(out.size() - 4), "ok\r\n");
     EXPECT_EQ(steps(0), 250);
 }
+
+TEST_F(Protocol, LineArrivingWhileThePlannerIsFullRunsOnceInOrderWhenRoomFrees) {
+    // Slow moves fill the planner; the lines after them wait in the receive buffer (a full
+    // planner defers the parse: GRBL would parse now and plan later), then run once, in order.
+    for (unsigned i = 1; i <= ll::kPlannerSize; ++i) {
+        d.send("G1 X" + std::to_string(i) + " F300\n");
+        EXPECT_EQ(d.run_until_responses(1), "ok\r\n");
+    }
+    d.send("G1 X17\nG91\nG1 X-0.5\n");
+    EXPECT_EQ(d.run_for(20 * kMs), ""); // they wait for room
+    EXPECT_LT(steps_now(0), 250);
+    EXPECT_EQ(d.run_until_idle(), "ok\r\nok\r\nok\r\n");
+    EXPECT_EQ(steps(0), 17 * 250 - 125);
+}
