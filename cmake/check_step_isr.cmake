@@ -20,6 +20,29 @@ foreach(name kStepEdgeOffsetD kVectorEntryCycles)
 endforeach()
 math(EXPR expect_edge "${kStepEdgeOffsetD} - ${kVectorEntryCycles}")
 
+# The vector table entry of each handler: 4 cycles of interrupt response, then rjmp (2 cycles,
+# what the linker's --relax makes of a jmp within 4 KiB) or jmp (3). kVectorEntryCycles must be
+# what the linked table gives.
+execute_process(COMMAND ${OBJDUMP} -d -z --start-address=0 --stop-address=0x68 ${FILE}
+                OUTPUT_VARIABLE table)
+string(REPLACE ";" "#" table "${table}")
+string(REPLACE "," ";" table_vectors "${VECTORS}")
+foreach(vec ${table_vectors})
+  if(NOT table MATCHES "\t(r?jmp)\t[^\n]*<${vec}>")
+    message(FATAL_ERROR "${FILE}: no vector table entry jumps to ${vec}")
+  endif()
+  if(CMAKE_MATCH_1 STREQUAL "rjmp")
+    set(entry 6)
+  else()
+    set(entry 7)
+  endif()
+  if(NOT entry EQUAL kVectorEntryCycles)
+    message(FATAL_ERROR "${FILE}: ${vec} is entered through ${CMAKE_MATCH_1}: ${entry} cycles "
+                        "from the compare match, step_timing.h says kVectorEntryCycles = "
+                        "${kVectorEntryCycles}")
+  endif()
+endforeach()
+
 string(REPLACE ";" "#" dis "${dis}") # objdump comments use ';', a CMake list separator
 # Brackets (in flash strings dumped as ASCII, e.g. "[VER:") would stop CMake from splitting.
 string(REPLACE "[" "(" dis "${dis}")

@@ -64,9 +64,12 @@ Sim::Sim(const Options& opt) : opt_(opt) {
     if (!avr_) throw SimError("llsim: simavr has no atmega328p core");
     // Diagnostic only: LLSIM_BIG_FLASH=1 gives the simulated chip 64 KiB of flash, so that an
     // image over the 328P's 32 KiB can still be run and measured (stack, timing) while it is
-    // being made smaller. Everything else stays the 328P's.
+    // being made smaller; LLSIM_BIG_RAM=1 gives it 4 KiB of RAM (for an image linked with
+    // -Wl,--defsym=__stack=0x800FFF). Everything else stays the 328P's.
     const char* big = getenv("LLSIM_BIG_FLASH");
     if (big && big[0] == '1') avr_->flashend = 0xFFFF;
+    const char* big_ram = getenv("LLSIM_BIG_RAM");
+    if (big_ram && big_ram[0] == '1') avr_->ramend = 0x0FFF;
     avr_init(avr_);
     avr_->log = static_cast<uint8_t>(opt_.log_level) & 0xF;
     avr_->frequency = kCpuHz;

@@ -197,6 +197,7 @@ class Sim {
     // ---- the simulator ----------------------------------------------------------------------
 
     avr_t* avr() { return avr_; }
+    const avr_t* avr() const { return avr_; }
     const Corrector& corrector() const { return *corr_; }
     /// CPU cycles simulated per wall-clock second, over every run so far.
     double speed() const;

@@ -27,15 +27,17 @@ constexpr uint16_t kPulseGuard = 16;
 constexpr uint16_t kPeriodMargin = 104;
 
 /// Cycles from a compare match to the first instruction of its handler on silicon, with the
-/// CPU on a one-cycle instruction: interrupt response 4, the vector's jmp 3. (simavr 1.6
-/// charges 0 for the response: subtract 4 from every offset below when reading its traces.)
-constexpr uint8_t kVectorEntryCycles = 7;
+/// CPU on a one-cycle instruction: interrupt response 4, the vector's rjmp 2 (the image is
+/// linked with --relax, which turns the table's jmp into rjmp; cmake/check_step_isr.cmake
+/// checks the linked table). (simavr 1.6 charges 0 for the response: subtract 4 from every
+/// offset below when reading its traces.)
+constexpr uint8_t kVectorEntryCycles = 6;
 
 /// Step edge (start of pulse) after the event: X/Y/Z (port D) and A (port B, 3 cycles later).
 /// Later by the time the CPU needs to accept the interrupt: up to 3 cycles of a multi-cycle
 /// instruction, up to kPulseGuard when another interrupt or a critical section is running.
-constexpr uint8_t kStepEdgeOffsetD = 10;
-constexpr uint8_t kStepEdgeOffsetB = 13;
+constexpr uint8_t kStepEdgeOffsetD = 9;
+constexpr uint8_t kStepEdgeOffsetB = 12;
 
 /// Pulse end after the model's pulse end (event + pulse): the same entry path as the step
 /// edge, kPulseGuard later. At a run's last event COMPA ends the pulse itself 0..2 cycles

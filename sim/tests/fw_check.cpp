@@ -22,8 +22,7 @@ namespace {
 
 namespace st = ll::step_timing;
 
-constexpr uint16_t kTccr1b = 0x81;  // data-space address of TCCR1B
-constexpr uint16_t kRamEnd = 0x8FF; // ATmega328P
+constexpr uint16_t kTccr1b = 0x81; // data-space address of TCCR1B
 constexpr uint8_t kPaint = 0xA5;
 constexpr uint8_t kClockSelect = 0x07; // CS12..CS10: non-zero while Timer1 counts
 constexpr uint64_t kLineTimeout = 200ull * 16000;
@@ -144,14 +143,16 @@ void paint_stack(Sim& sim) {
     const uint32_t bss_end = sim.symbol("__bss_end");
     // Below the current stack pointer only: what is above it is in use.
     const uint16_t sp = static_cast<uint16_t>(sim.peek(0x5D) | sim.peek(0x5E) << 8);
-    for (uint32_t a = bss_end; a <= sp && a <= kRamEnd; ++a) sim.avr()->data[a] = kPaint;
+    const uint32_t ram_end = sim.avr()->ramend; // 0x8FF (LLSIM_BIG_RAM: 0xFFF)
+    for (uint32_t a = bss_end; a <= sp && a <= ram_end; ++a) sim.avr()->data[a] = kPaint;
 }
 
 std::pair<uint16_t, uint16_t> stack_high_water(const Sim& sim) {
     const uint32_t bss_end = sim.symbol("__bss_end");
+    const uint32_t ram_end = sim.avr()->ramend;
     uint32_t a = bss_end;
-    while (a <= kRamEnd && sim.peek(static_cast<uint16_t>(a)) == kPaint) ++a;
-    return {static_cast<uint16_t>(kRamEnd + 1 - a), static_cast<uint16_t>(a - bss_end)};
+    while (a <= ram_end && sim.peek(static_cast<uint16_t>(a)) == kPaint) ++a;
+    return {static_cast<uint16_t>(ram_end + 1 - a), static_cast<uint16_t>(a - bss_end)};
 }
 
 Trace run_on_chip(const Job& job) {

@@ -61,9 +61,11 @@ void check_curve(const std::string& line, const std::function<Point(double)>& cu
     ASSERT_GT(pts.size(), 100u);
     const double worst = lltest::worst_distance(pts, curve);
     printf("[ measured ] %s: %zu positions, worst distance %.3f step, end (%g, %g), "
-           "%.3f s, starvations %u\n",
+           "%.3f s, starvations %u, stack %u bytes (%u never touched)\n",
            line.c_str(), pts.size(), worst, pts.back().x, pts.back().y,
-           static_cast<double>(chip.cycles) / 16e6, chip.starvations);
+           static_cast<double>(chip.cycles) / 16e6, chip.starvations, chip.stack_bytes,
+           chip.stack_free);
+    EXPECT_GT(chip.stack_free, 0u) << "the stack reached the static RAM";
     EXPECT_LE(worst, 1.0);
     EXPECT_EQ(pts.back().x, end.x);
     EXPECT_EQ(pts.back().y, end.y);

@@ -15,7 +15,6 @@ using namespace ll::sim::fw;
 
 namespace {
 
-constexpr uint16_t kRamEnd = 0x8FF;
 constexpr uint16_t kTccr1b = 0x81; // data-space address
 /// Headroom for what a session cannot force: interrupts nested on top of the deepest main-loop
 /// point. Receive stub + drain 12 bytes, then the transmit (10) and Timer2 (9) handlers, which
@@ -33,6 +32,7 @@ struct MainLoop {
     uint32_t latency_ret = 0; ///< return address on top of the stack there (the caller of a
                               ///< hal::irq_save())
     uint32_t bss_end = 0;
+    uint16_t ram_end = 0; ///< 0x8FF (LLSIM_BIG_RAM: 0xFFF)
     std::string output;
 };
 
@@ -40,6 +40,7 @@ MainLoop run_session() {
     MainLoop r;
     Sim sim(firmware_elf());
     r.bss_end = sim.symbol("__bss_end");
+    r.ram_end = sim.avr()->ramend;
     for (uint8_t v = 1; v < 26; ++v) sim.record_isr(v);
     size_t closed = 0;      // isr_spans() below this index have all returned
     uint64_t off_since = 0; // first cycle of the current interrupts-off window
@@ -96,26 +97,14 @@ MainLoop run_session() {
         }
     };
     run(ms(150)); // boot from a blank EEPROM: error:7, the defaults written and listed
-    const std::vector<std::string> session = {"$$",
-                                              "$#",
-                                              "$G",
-                                              "$I",
-                                              "$100=80",
-                                              "$101=80",
-                                              "$102=80",
-                                              "$103=80",
-                                              "$110=6000",
-                                              "$111=6000",
-                                              "$120=500",
-                                              "$121=500",
-                                              "G10 L2 P1 X1 Y2",
-                                              "G92 X0",
-                                              "G21 G90 G1 X10.125 Y-3.25 Z1.5 A2 F3000",
-                                              "G91 G1 X-1.2345 Y0.5 Z-0.25 A-1 F2000",
-                                              "G20 G1 X0.1 Y-0.05",
-                                              "G21 G90 G0 X0 Y0 Z0 A0",
-                                              "G4 P0.01",
-                                              "G1 X5 Y5 F2500"};
+    const std::vector<std::string> session = {
+        "$$", "$#", "$G", "$I", "$100=80", "$101=80", "$102=80", "$103=80", "$110=6000",
+        "$111=6000", "$120=500", "$121=500", "G10 L2 P1 X1 Y2", "G92 X0",
+        "G21 G90 G1 X10.125 Y-3.25 Z1.5 A2 F3000", "G91 G1 X-1.2345 Y0.5 Z-0.25 A-1 F2000",
+        "G20 G1 X0.1 Y-0.05", "G21 G90 G0 X0 Y0 Z0 A0", "G4 P0.01", "G1 X5 Y5 F2500",
+        // Curves plan and step deepest (issue 5).
+        "G2 X5 Y5 I5 J0 F3000", "G3.1 I-3 J0 P3 Q2 F3000", "G5 I1 J2 P-1 Q2 X9 Y7",
+        "G5 P1 Q-2 X12 Y5", "G18 G2 X8 Z2 R3", "G17"};
     for (const std::string& line : session) {
         sim.send(line + "\n");
         run(ms(12));
@@ -146,7 +135,7 @@ const MainLoop& session() {
 TEST(FirmwareStack, DeepestPathLeavesRoomAboveTheStaticRam) {
     REQUIRE_FIRMWARE();
     const MainLoop& r = session();
-    const int depth = kRamEnd - r.min_sp;
+    const int depth = r.ram_end - r.min_sp;
     const int room = static_cast<int>(r.min_sp) + 1 - static_cast<int>(r.bss_end);
     printf("[ measured ] stack: %d bytes deep (SP 0x%04x at pc 0x%04x), static RAM %u bytes, "
            "%d bytes left above __bss_end 0x%04x\n",
