@@ -100,14 +100,18 @@ MainLoop run_session() {
     const std::vector<std::string> session = {
         "$$", "$#", "$G", "$I", "$100=80", "$101=80", "$102=80", "$103=80", "$110=6000",
         "$111=6000", "$120=500", "$121=500", "G10 L2 P1 X1 Y2", "G92 X0",
-        "G21 G90 G1 X10.125 Y-3.25 Z1.5 A2 F3000", "G91 G1 X-1.2345 Y0.5 Z-0.25 A-1 F2000",
-        "G20 G1 X0.1 Y-0.05", "G21 G90 G0 X0 Y0 Z0 A0", "G4 P0.01", "G1 X5 Y5 F2500",
-        // Curves plan and step deepest (issue 5).
-        "G2 X5 Y5 I5 J0 F3000", "G3.1 I-3 J0 P3 Q2 F3000", "G5 I1 J2 P-1 Q2 X9 Y7",
-        "G5 P1 Q-2 X12 Y5", "G18 G2 X8 Z2 R3", "G17"};
+        // Curves plan and step deepest (issue 5): small ones, each done before the next line.
+        "G91 G2 X0 Y0 I0.5 J0 F3000", "G3.1 I-0.3 J0 P0.3 Q0.2",
+        "G5 I0.1 J0.2 P-0.1 Q0.2 X0.9 Y0.7", "G5 P0.1 Q-0.2 X0.3 Y-0.2", "G18 G2 X-0.4 Z0.2 R0.3",
+        "G17 G90 G0 X0 Y0 Z0", "G21 G90 G1 X10.125 Y-3.25 Z1.5 A2 F3000",
+        "G91 G1 X-1.2345 Y0.5 Z-0.25 A-1 F2000", "G20 G1 X0.1 Y-0.05", "G21 G90 G0 X0 Y0 Z0 A0",
+        "G4 P0.01", "G1 X5 Y5 F2500"};
     for (const std::string& line : session) {
         sim.send(line + "\n");
-        run(ms(12));
+        // A curve runs long enough to be planned (an ellipse: 90 ms) and stepped for a while.
+        const bool curve = line.compare(0, 2, "G2") == 0 || line.compare(0, 2, "G3") == 0 ||
+                           line.compare(0, 2, "G5") == 0;
+        run(ms(curve ? 150 : 12));
         sim.send("?");
         run(ms(3));
     }
