@@ -7,11 +7,16 @@ uint32_t min32(uint32_t a, uint32_t b) {
     return a < b ? a : b;
 }
 
-// The per-axis limits, read straight from the settings: maximum rates (units/min x1000) and
-// accelerations (units/s^2 x1000, which scale to units/min^2 by x3.6).
-enum Limit : uint8_t { kRate = 0, kAccel = 1 };
-uint32_t axis_limit(const Settings& s, uint8_t a, Limit which) {
-    return which == kRate ? s.axis[a].max_rate : s.axis[a].accel;
+// The per-axis limits are read straight from the settings: maximum rates (units/min x1000) and
+// accelerations (units/s^2 x1000, which scale to units/min^2 by x3.6), one field of AxisSettings
+// chosen by a member pointer (an offset: one loop serves both).
+using Limit = uint32_t AxisSettings::*;
+constexpr Limit kRate = &AxisSettings::max_rate;
+constexpr Limit kAccel = &AxisSettings::accel;
+
+// v, at least 1 (speeds and accelerations are divisors downstream).
+uint32_t at_least_1(uint32_t v) {
+    return v ? v : 1;
 }
 
 // Normalised constants for Num::mulc().
@@ -30,13 +35,16 @@ bool ratio_less(uint32_t n1, uint32_t d1, uint32_t n2, uint32_t d2) {
 
 // The axis with comp[a] > 0 whose lim[a] / comp[a] is the smallest (the first one on a tie),
 // kAxes when every comp[a] is 0.
-uint8_t tightest(const Settings& s, Limit which, const uint32_t comp[kAxes]) {
+uint8_t tightest(const AxisSettings* ax, Limit which, const uint32_t comp[kAxes]) {
     uint8_t best = kAxes;
+    uint32_t best_lim = 0, best_comp = 0;
     for (uint8_t a = 0; a < kAxes; ++a) {
-        if (comp[a] == 0) continue;
-        if (best == kAxes ||
-            ratio_less(axis_limit(s, a, which), comp[a], axis_limit(s, best, which), comp[best])) {
+        const uint32_t c = comp[a], lim = ax[a].*which;
+        if (c == 0) continue;
+        if (best == kAxes || ratio_less(lim, c, best_lim, best_comp)) {
             best = a;
+            best_lim = lim;
+            best_comp = c;
         }
     }
     return best;
@@ -52,27 +60,41 @@ Num norm(const uint32_t v[kAxes]) {
     return sum_squares(v, kAxes).sqrt();
 }
 
-} // namespace
-
-namespace {
-
 // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated length:
 // Euclidean over the move's group (seed §3.1), at least 1.
 uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uint32_t x[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
-    uint32_t len = sum_squares(x, kAxes, group).sqrt().u32();
-    return len ? len : 1;
+    return at_least_1(sum_squares(x, kAxes, group).sqrt().u32());
 }
 
 // Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
 // of the plane's two axes bounds it (and the normal axis' when a helix moves it).
-uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
-    uint8_t ax[3];
-    plane_axes(plane, ax);
+uint32_t curve_accel(const Machine& m, const uint8_t ax[3], bool w_moves) {
     uint32_t acc = 0xFFFFFFFFul;
     for (uint8_t k = 0; k < (w_moves ? 3 : 2); ++k) acc = min32(acc, m.settings->axis[ax[k]].accel);
-    uint32_t v = Num(acc).mul(18).div(5).u32(); // units/s^2 x1000 -> units/min^2
-    return v ? v : 1;
+    return at_least_1(Num(acc).mul(18).div(5).u32()); // units/s^2 x1000 -> units/min^2
+}
+
+// Squared speed of a feed (units/min x1000), (units/min)^2.
+uint32_t speed2_of(uint32_t feed) {
+    Num v(feed);
+    return v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
+}
+
+// Writes the 24-bit deltas of a block.
+void pack(PlanBlock& b, const int32_t d[kAxes]) {
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        uint32_t v = static_cast<uint32_t>(d[a]);
+        b.delta[a][0] = static_cast<uint8_t>(v);
+        b.delta[a][1] = static_cast<uint8_t>(v >> 8);
+        b.delta[a][2] = static_cast<uint8_t>(v >> 16);
+    }
+}
+
+// A curve's end tangent (u, v, w; w only when `n` is 3) as a machine-axis vector.
+void place(int32_t out[kAxes], const int32_t dir[3], const uint8_t ax[3], uint8_t n) {
+    for (uint8_t a = 0; a < kAxes; ++a) out[a] = 0;
+    for (uint8_t k = 0; k < n; ++k) out[ax[k]] = dir[k];
 }
 
 } // namespace
@@ -82,19 +104,18 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
     out.len_q8 = travel(m, delta, group, x);
     // limit_along() for both limits, sharing len / x[a] when one axis bounds both (the common
     // case): one division.
-    const Settings& s = *m.settings;
-    uint8_t ar = tightest(s, kRate, x), aa = tightest(s, kAccel, x);
+    const AxisSettings* ax = m.settings->axis;
+    uint8_t ar = tightest(ax, kRate, x), aa = tightest(ax, kAccel, x);
     if (ar == kAxes) {
         out.vmax = out.accel = 0xFFFFFFFFul; // nothing moves
         return;
     }
     Num r(out.len_q8);
     r.div(x[ar]);
-    uint32_t v = r.of(s.axis[ar].max_rate);
-    out.vmax = v ? v : 1;
+    out.vmax = at_least_1(r.of(ax[ar].max_rate));
     if (aa != ar) r.set(out.len_q8).div(x[aa]);
-    v = r.mulc(k3_6, k3_6e).of(s.axis[aa].accel); // units/s^2 x1000 -> units/min^2
-    out.accel = v ? v : 1;
+    // units/s^2 x1000 -> units/min^2
+    out.accel = at_least_1(r.mulc(k3_6, k3_6e).of(ax[aa].accel));
 }
 
 int32_t Planner::delta(const PlanBlock& b, uint8_t axis) {
@@ -116,18 +137,12 @@ void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
     }
 }
 
-namespace {
-
-// Squared speed of a feed (units/min x1000), (units/min)^2.
-uint32_t speed2_of(uint32_t feed) {
-    Num v(feed);
-    return v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
-}
-
-} // namespace
-
 uint32_t Planner::nominal2(const PlanBlock& b) {
     return speed2_of(b.feed);
+}
+
+PlanBlock* Planner::at(uint8_t i) {
+    return &ring_[index(i)];
 }
 
 // Junction speed squared with the previous move (GRBL's junction deviation, $11), from the
@@ -140,10 +155,10 @@ uint32_t Planner::nominal2(const PlanBlock& b) {
 uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     uint32_t dc[kAxes];
     uint32_t a_min = 0xFFFFFFFFul;
-    const Settings& s = *m_->settings;
+    const AxisSettings* ax = m_->settings->axis;
     for (uint8_t a = 0; a < kAxes; ++a) {
         dc[a] = abs32(unit[a] - prev_unit_[a]); // <= 2^30
-        if (dc[a] != 0 && s.axis[a].accel < a_min) a_min = s.axis[a].accel;
+        if (dc[a] != 0) a_min = min32(a_min, ax[a].accel);
     }
     Num q = sum_squares(dc, kAxes); // |d|^2 / 4
     q.shift(-60);
@@ -156,63 +171,56 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     //   v_junction^2 >= a_min x 3.6 x delta / (2000 q) >= limit  when  a_min delta >= 1024 q limit
     // (a margin of 1.8 over every truncation below): then the junction does not limit.
     // Nearly straight chains of short segments (the common case) stop here.
+    Num t, r;
     if (q.e < -32) {
-        Num lhs(a_min);
-        Num rhs(limit);
-        if (lhs.mul(m_->junction_dev_um).cmp(rhs.mul(q).shift(10)) >= 0) return 0xFFFFFFFFul;
+        t.set(a_min).mul(m_->junction_dev_um);
+        if (t.cmp(r.set(limit).mul(q).shift(10)) >= 0) return 0xFFFFFFFFul;
     }
     // The exact formula (rare in chains of short segments).
     // p = 1 - q to 2^-32: near a reversal (p small) its relative error grows to 2^-11 at the
     // 5e-7 threshold, where v_junction^2 is a few (mm/min)^2, well within a unit.
-    Num t = q;
+    t = q;
     t.set(~t.shift(32).u32(), -32);
     if (tiny(t)) return 0;
-    Num r(1);
-    t.sqrt();               // sin(theta / 2)
-    r.add(t).mul(t).div(q); // (1 + sin) sin / q
+    t.sqrt();                      // sin(theta / 2)
+    r.set(1).add(t).mul(t).div(q); // (1 + sin) sin / q
     // Acceleration along the junction vector d, limited per axis (GRBL's
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
     // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
     // 1000.
-    uint8_t a = tightest(s, kAccel, dc);
+    uint8_t a = tightest(ax, kAccel, dc);
     t = q;
     t.sqrt().shift(30).mulc(k3_6, k3_6e);
-    uint32_t ja = Num(s.axis[a].accel).div(dc[a]).mul(t).u32();
-    r.mul(ja ? ja : 1).mul(m_->junction_dev_um);
+    r.mul(at_least_1(Num(ax[a].accel).div(dc[a]).mul(t).u32())).mul(m_->junction_dev_um);
     return r.mulc(kMilli, -41).u32(); // / 1000
+}
+
+bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) {
+    bool moves = false;
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        d[a] = target[a] - last_[a];
+        last_[a] = target[a];
+        if (d[a] != 0) moves = true;
+    }
+    pack(b, d);
+    return moves;
 }
 
 bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                   bool rapid) {
     // Few locals, in scopes that do not overlap (they share their stack slots): the deepest
     // stack of the firmware runs through here.
-    PlanBlock& b = ring_[index(count_)];
+    PlanBlock& b = *at(count_);
     uint8_t group;
+    MoveLimits lim;
     {
         int32_t d[kAxes];
-        bool moves = false;
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            d[a] = target[a] - last_[a];
-            if (d[a] != 0) moves = true;
-        }
-        if (!moves) {
+        if (!open(b, target, d)) {
             for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
             return false;
         }
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            last_[a] = target[a];
-            uint32_t v = static_cast<uint32_t>(d[a]);
-            b.delta[a][0] = static_cast<uint8_t>(v);
-            b.delta[a][1] = static_cast<uint8_t>(v >> 8);
-            b.delta[a][2] = static_cast<uint8_t>(v >> 16);
-        }
         group = regulated_group(*m_, d);
-        b.group = group;
-        MoveLimits lim;
         move_limits(*m_, d, group, lim);
-        b.len_q8 = lim.len_q8;
-        b.feed = rapid || feed > lim.vmax ? lim.vmax : feed;
-        if (b.feed == 0) b.feed = 1;
         // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000.
         uint32_t lo, hi = mul_wide(lim.len_q8, lim.accel, lo);
         b.dv2 = num64(hi, lo).mulc(kMilli, -48).u32();
@@ -239,17 +247,20 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
     b.curve = 0;
-    finish_block(b, unit, unit);
+    finish_block(b, group, rapid ? lim.vmax : min32(feed, lim.vmax), lim.len_q8, unit);
+    for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
     return true;
 }
 
-void Planner::finish_block(PlanBlock& b, const int32_t unit_in[kAxes],
-                           const int32_t unit_out[kAxes]) {
+void Planner::finish_block(PlanBlock& b, uint8_t group, uint32_t feed, uint32_t len_q8,
+                           const int32_t unit_in[kAxes]) {
+    b.group = group;
+    b.len_q8 = len_q8;
+    b.feed = at_least_1(feed);
     // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
-    uint32_t limit = count_ > 0 ? speed2_of(min32(b.feed, ring_[index(count_ - 1)].feed)) : 0;
-    uint32_t v_junction2 = prev_group_ == b.group && count_ > 0 ? junction2(unit_in, limit) : 0;
-    for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit_out[a];
-    prev_group_ = b.group;
+    uint32_t limit = count_ > 0 ? speed2_of(min32(b.feed, at(count_ - 1)->feed)) : 0;
+    uint32_t v_junction2 = prev_group_ == group && count_ > 0 ? junction2(unit_in, limit) : 0;
+    prev_group_ = group;
     b.v_max_entry2 = min32(v_junction2, limit);
     b.v_entry2 = 0;
     ++count_;
@@ -260,9 +271,7 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
                         const CurveParams& curve) {
     uint8_t ax[3];
     plane_axes(curve.plane, ax);
-    int32_t d[kAxes];
-    for (uint8_t a = 0; a < kAxes; ++a) d[a] = target[a] - last_[a];
-    const uint8_t group = m_->group_of[ax[0] < ax[1] ? ax[0] : ax[1]];
+    const uint8_t group = m_->group_of[min32(ax[0], ax[1])];
     const bool w_reg = (group & (1u << ax[2])) != 0;
     const int32_t dw_um = target_um[ax[2]] - last_um_[ax[2]];
     CurveShape shape;
@@ -271,47 +280,34 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     while (curve_used_ & (1u << slot)) ++slot;
     curve_used_ = static_cast<uint8_t>(curve_used_ | (1u << slot));
     curves_[slot] = curve;
-    PlanBlock& b = ring_[index(count_)];
+    PlanBlock& b = *at(count_);
     b.curve = static_cast<uint8_t>(slot + 1);
-    b.len_q8 = shape.len_q8;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        last_[a] = target[a];
-        last_um_[a] = target_um[a];
-        uint32_t v = static_cast<uint32_t>(d[a]);
-        b.delta[a][0] = static_cast<uint8_t>(v);
-        b.delta[a][1] = static_cast<uint8_t>(v >> 8);
-        b.delta[a][2] = static_cast<uint8_t>(v >> 16);
-    }
-    b.group = group;
+    int32_t d[kAxes];
+    open(b, target, d);
+    for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
     // Speed: the requested feed, within the plane axes' rates (the tangent takes every
     // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L), and
     // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
     // sqrt(a r 1000) with a in units/min^2 and r in µm.
-    const Settings& st = *m_->settings;
-    uint32_t vmax = min32(st.axis[ax[0]].max_rate, st.axis[ax[1]].max_rate);
+    const AxisSettings* st = m_->settings->axis;
+    uint32_t vmax = min32(st[ax[0]].max_rate, st[ax[1]].max_rate);
     if (dw_um != 0) {
-        uint32_t vw =
-            Num(st.axis[ax[2]].max_rate).mul(shape.len_q8).div(abs32(dw_um)).shift(-8).u32();
-        vmax = min32(vmax, vw);
+        vmax = min32(vmax,
+                     Num(st[ax[2]].max_rate).mul(shape.len_q8).div(abs32(dw_um)).shift(-8).u32());
     }
-    const uint32_t accel = curve_accel(*m_, curve.plane, d[ax[2]] != 0);
+    const uint32_t accel = curve_accel(*m_, ax, d[ax[2]] != 0);
     vmax = min32(vmax, Num(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
-    b.feed = min32(feed, vmax);
-    if (b.feed == 0) b.feed = 1;
     b.dv2 = Num(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
-    int32_t in[kAxes] = {}, out[kAxes] = {};
-    for (uint8_t k = 0; k < 3; ++k) {
-        if (k == 2 && !w_reg) continue;
-        in[ax[k]] = shape.start_dir[k];
-        out[ax[k]] = shape.end_dir[k];
-    }
-    finish_block(b, in, out);
+    const uint8_t n = w_reg ? 3 : 2;
+    place(d, shape.start_dir, ax, n);
+    finish_block(b, group, min32(feed, vmax), shape.len_q8, d);
+    place(prev_unit_, shape.end_dir, ax, n);
     return true;
 }
 
 void Planner::recalculate(bool all) {
-    // Pointer walks (an index modulo the ring and a 33-byte stride per block cost more than the
+    // Pointer walks (an index modulo the ring and a 34-byte stride per block cost more than the
     // passes themselves on the ATmega328P).
     PlanBlock* const first = ring_;
     PlanBlock* const last = ring_ + (kPlannerSize - 1);
@@ -322,7 +318,7 @@ void Planner::recalculate(bool all) {
     // keeps its entry: the passes stop there (in a chain of short moves, a few moves from the
     // end instead of the whole ring). Only while the oldest move is being executed: its entry
     // is then fixed, as it was at the last pass; otherwise it is recomputed from scratch.
-    PlanBlock* b = &ring_[index(static_cast<uint8_t>(count_ - 1))];
+    PlanBlock* b = at(static_cast<uint8_t>(count_ - 1));
     uint32_t next_entry = 0;
     uint8_t pos = count_;
     uint8_t from = 0; // where the forward pass starts
@@ -340,7 +336,7 @@ void Planner::recalculate(bool all) {
         b = b == first ? last : b - 1;
     }
     // Forward pass: no move can enter faster than the previous one can accelerate to.
-    b = &ring_[index(from)];
+    b = at(from);
     for (uint8_t n = static_cast<uint8_t>(count_ - from); n > 1; --n) {
         uint32_t reach = add_sat(b->v_entry2, b->dv2);
         b = b == last ? first : b + 1;
@@ -362,7 +358,7 @@ MoveSpec Planner::spec_of_first() const {
         if (s.curve) {
             uint8_t ax[3];
             plane_axes(s.curve->plane, ax);
-            s.accel = curve_accel(*m_, s.curve->plane, s.delta[ax[2]] != 0);
+            s.accel = curve_accel(*m_, ax, s.delta[ax[2]] != 0);
         } else {
             MoveLimits lim;
             move_limits(*m_, s.delta, b.group, lim);

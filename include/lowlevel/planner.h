@@ -89,13 +89,22 @@ class Planner {
 
   private:
     uint8_t index(uint8_t i) const { return static_cast<uint8_t>((head_ + i) % kPlannerSize); }
+    /// The i-th queued move (0 = oldest; count_ for the one being queued).
+    PlanBlock* at(uint8_t i);
     /// The look-ahead passes; `all`: do not stop where nothing changes (after a restart).
     void recalculate(bool all = false);
     /// Junction speed squared with the previous move, or any value >= `limit` when it is at
     /// least that (the caller takes the minimum).
     uint32_t junction2(const int32_t unit[kAxes], uint32_t limit) const;
 
-    void finish_block(PlanBlock& b, const int32_t unit_in[kAxes], const int32_t unit_out[kAxes]);
+    /// Writes the move from the last target to `target` (steps) into `b` and `d`; `target`
+    /// becomes the last target. Returns false when no axis moves.
+    bool open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]);
+    /// Completes the block being queued (its deltas, curve and dv2 written): feed (at least 1),
+    /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes. The
+    /// caller then sets prev_unit_ to the direction it ends along.
+    void finish_block(PlanBlock& b, uint8_t group, uint32_t feed, uint32_t len_q8,
+                      const int32_t unit_in[kAxes]);
 
     const Machine* m_;
     uint8_t curve_used_; ///< bit i: curves_[i] belongs to a queued move
