@@ -15,7 +15,7 @@ constexpr Limit kRate = &AxisSettings::max_rate;
 constexpr Limit kAccel = &AxisSettings::accel;
 
 // v, at least 1 (speeds and accelerations are divisors downstream).
-uint32_t at_least_1(uint32_t v) {
+__attribute__((noinline)) uint32_t at_least_1(uint32_t v) {
     return v ? v : 1;
 }
 
