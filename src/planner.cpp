@@ -51,13 +51,8 @@ uint8_t tightest(const AxisSettings* ax, Limit which, const uint32_t comp[kAxes]
 }
 
 // x <= 5e-7 (GRBL's junction thresholds): 5e-7 = kMicro 2^-52.
-bool tiny(const Num& x) {
+__attribute__((noinline)) bool tiny(const Num& x) {
     return x.m == 0 || x.e < -52 || (x.e == -52 && x.m <= kMicro);
-}
-
-// Euclidean norm of kAxes 32-bit components.
-Num norm(const uint32_t v[kAxes]) {
-    return sum_squares(v, kAxes).sqrt();
 }
 
 // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated length:
@@ -238,8 +233,9 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (du < 0) neg = static_cast<uint8_t>(neg | bit);
         xu[a] = (in_group & 1) ? abs32(du) : 0;
     }
+    Num n = sum_squares(xu, kAxes);
     Num to_unit(1, 29);
-    to_unit.div(norm(xu));
+    to_unit.div(n.sqrt());
     int32_t* unit = reinterpret_cast<int32_t*>(xu);
     for (uint8_t a = 0; a < kAxes; ++a, neg >>= 1) {
         uint32_t u = to_unit.of(xu[a]);
