@@ -76,6 +76,15 @@ uint32_t speed2_of(uint32_t feed) {
     return v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
 }
 
+// The axes of a plane as plane_axes() gives them, by rotation: ax[k] = (k - plane) mod 3.
+void axes_of(uint8_t plane, uint8_t ax[3]) {
+    uint8_t v = plane ? static_cast<uint8_t>(3 - plane) : 0;
+    for (uint8_t k = 0; k < 3; ++k) {
+        ax[k] = v;
+        v = v == 2 ? 0 : static_cast<uint8_t>(v + 1);
+    }
+}
+
 // Writes the 24-bit deltas of a block.
 void pack(PlanBlock& b, const int32_t d[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) {
@@ -266,14 +275,14 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint32_t feed, uint32_t 
 bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                         const CurveParams& curve) {
     uint8_t ax[3];
-    plane_axes(curve.plane, ax);
+    axes_of(curve.plane, ax);
     const uint8_t group = m_->group_of[min32(ax[0], ax[1])];
-    const bool w_reg = (group & (1u << ax[2])) != 0;
+    const uint8_t n = (group >> ax[2]) & 1 ? 3 : 2; // 3: the normal axis w is regulated
     const int32_t dw_um = target_um[ax[2]] - last_um_[ax[2]];
     CurveShape shape;
-    if (!curve_shape(curve, w_reg ? dw_um : 0, w_reg, shape)) return false;
+    if (!curve_shape(curve, n == 3 ? dw_um : 0, n == 3, shape)) return false;
     uint8_t slot = 0;
-    while (curve_used_ & (1u << slot)) ++slot;
+    while ((curve_used_ >> slot) & 1) ++slot;
     curve_used_ = static_cast<uint8_t>(curve_used_ | (1u << slot));
     curves_[slot] = curve;
     PlanBlock& b = *at(count_);
@@ -286,18 +295,18 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
     // sqrt(a r 1000) with a in units/min^2 and r in µm.
     const AxisSettings* st = m_->settings->axis;
-    uint32_t vmax = min32(st[ax[0]].max_rate, st[ax[1]].max_rate);
+    feed = min32(feed, min32(st[ax[0]].max_rate, st[ax[1]].max_rate));
+    Num t;
     if (dw_um != 0) {
-        vmax = min32(vmax,
-                     Num(st[ax[2]].max_rate).mul(shape.len_q8).div(abs32(dw_um)).shift(-8).u32());
+        feed = min32(feed,
+                     t.set(st[ax[2]].max_rate).mul(shape.len_q8).div(abs32(dw_um)).shift(-8).u32());
     }
     const uint32_t accel = curve_accel(*m_, ax, d[ax[2]] != 0);
-    vmax = min32(vmax, Num(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
-    b.dv2 = Num(shape.len_q8).mul(accel).div(128000).u32();
+    feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
+    b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
-    const uint8_t n = w_reg ? 3 : 2;
     place(d, shape.start_dir, ax, n);
-    finish_block(b, group, min32(feed, vmax), shape.len_q8, d);
+    finish_block(b, group, feed, shape.len_q8, d);
     place(prev_unit_, shape.end_dir, ax, n);
     return true;
 }
@@ -353,7 +362,7 @@ MoveSpec Planner::spec_of_first() const {
         s.dv2 = 0;
         if (s.curve) {
             uint8_t ax[3];
-            plane_axes(s.curve->plane, ax);
+            axes_of(s.curve->plane, ax);
             s.accel = curve_accel(*m_, ax, s.delta[ax[2]] != 0);
         } else {
             MoveLimits lim;
