@@ -350,14 +350,19 @@ void Planner::recalculate(bool all) {
 }
 
 MoveSpec Planner::spec_of_first() const {
-    const PlanBlock& b = ring_[head_];
+    const PlanBlock* const b = ring_ + head_;
     MoveSpec s;
-    for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(b, a);
-    s.len_q8 = b.len_q8;
+    for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(*b, a);
+    s.len_q8 = b->len_q8;
+    s.feed = b->feed;
+    s.v_entry2 = b->v_entry2;
+    s.group = b->group;
+    s.v_nominal2 = nominal2(*b);
+    s.v_exit2 = exit2_of_first();
+    s.curve = b->curve ? &curves_[b->curve - 1] : nullptr;
     s.accel = 0;
-    s.dv2 = b.dv2; // the profile from the planner's own 2 a L
-    s.curve = b.curve ? &curves_[b.curve - 1] : nullptr;
-    if (b.dv2 == 0xFFFFFFFFul) {
+    s.dv2 = b->dv2; // the profile from the planner's own 2 a L
+    if (s.dv2 == 0xFFFFFFFFul) {
         // dv2 saturated: the acceleration from the limits again.
         s.dv2 = 0;
         if (s.curve) {
@@ -366,15 +371,10 @@ MoveSpec Planner::spec_of_first() const {
             s.accel = curve_accel(*m_, ax, s.delta[ax[2]] != 0);
         } else {
             MoveLimits lim;
-            move_limits(*m_, s.delta, b.group, lim);
+            move_limits(*m_, s.delta, s.group, lim);
             s.accel = lim.accel;
         }
     }
-    s.feed = b.feed;
-    s.v_entry2 = b.v_entry2;
-    s.v_nominal2 = nominal2(b);
-    s.v_exit2 = exit2_of_first();
-    s.group = b.group;
     return s;
 }
 
