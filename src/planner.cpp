@@ -276,14 +276,15 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
                         const CurveParams& curve) {
     uint8_t ax[3];
     axes_of(curve.plane, ax);
-    const uint8_t group = m_->group_of[min32(ax[0], ax[1])];
+    const uint8_t group = m_->group_of[ax[0] < ax[1] ? ax[0] : ax[1]];
     const uint8_t n = (group >> ax[2]) & 1 ? 3 : 2; // 3: the normal axis w is regulated
     const int32_t dw_um = target_um[ax[2]] - last_um_[ax[2]];
     CurveShape shape;
     if (!curve_shape(curve, n == 3 ? dw_um : 0, n == 3, shape)) return false;
-    uint8_t slot = 0;
-    while ((curve_used_ >> slot) & 1) ++slot;
-    curve_used_ = static_cast<uint8_t>(curve_used_ | (1u << slot));
+    // The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
+    static_assert(kCurveSlots == 2, "one free slot out of two");
+    const uint8_t slot = curve_used_ & 1;
+    curve_used_ = static_cast<uint8_t>(curve_used_ | (slot + 1));
     curves_[slot] = curve;
     PlanBlock& b = *at(count_);
     b.curve = static_cast<uint8_t>(slot + 1);
@@ -385,7 +386,7 @@ uint32_t Planner::exit2_of_first() const {
 void Planner::discard_first() {
     if (!count_) return;
     const PlanBlock& b = ring_[head_];
-    if (b.curve) curve_used_ = static_cast<uint8_t>(curve_used_ & ~(1u << (b.curve - 1)));
+    curve_used_ = static_cast<uint8_t>(curve_used_ & ~b.curve); // slot s: curve s + 1, bit s + 1
     head_ = index(1);
     --count_;
     first_begun_ = 0;
