@@ -164,8 +164,10 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
         dc[a] = abs32(unit[a] - prev_unit_[a]); // <= 2^30
         if (dc[a] != 0) a_min = min32(a_min, ax[a].accel);
     }
-    Num q = sum_squares(dc, kAxes); // |d|^2 / 4
-    q.shift(-60);
+    // |d|^2 / 4. Exponents are adjusted in place below (no Num::shift()): a zero stays zero
+    // whatever its exponent.
+    Num q = sum_squares(dc, kAxes);
+    q.e = static_cast<int8_t>(q.e - 60);
     // GRBL's thresholds: |cos theta| > 0.999999 is straight on (no limit) or a reversal
     // (stop), i.e. q or p below 5e-7.
     if (tiny(q)) return 0xFFFFFFFFul;
@@ -178,13 +180,16 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     Num t, r;
     if (q.e < -32) {
         t.set(a_min).mul(m_->junction_dev_um);
-        if (t.cmp(r.set(limit).mul(q).shift(10)) >= 0) return 0xFFFFFFFFul;
+        r.set(limit).mul(q);
+        r.e = static_cast<int8_t>(r.e + 10);
+        if (t.cmp(r) >= 0) return 0xFFFFFFFFul;
     }
     // The exact formula (rare in chains of short segments).
     // p = 1 - q to 2^-32: near a reversal (p small) its relative error grows to 2^-11 at the
     // 5e-7 threshold, where v_junction^2 is a few (mm/min)^2, well within a unit.
-    t = q;
-    t.set(~t.shift(32).u32(), -32);
+    q.e = static_cast<int8_t>(q.e + 32);
+    t.set(~q.u32(), -32);
+    q.e = static_cast<int8_t>(q.e - 32);
     if (tiny(t)) return 0;
     t.sqrt();                      // sin(theta / 2)
     r.set(1).add(t).mul(t).div(q); // (1 + sin) sin / q
@@ -193,9 +198,10 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
     // 1000.
     uint8_t a = tightest(ax, kAccel, dc);
-    t = q;
-    t.sqrt().shift(30).mulc(k3_6, k3_6e);
-    r.mul(at_least_1(Num(ax[a].accel).div(dc[a]).mul(t).u32())).mul(m_->junction_dev_um);
+    q.sqrt();
+    q.e = static_cast<int8_t>(q.e + 30);
+    q.mulc(k3_6, k3_6e);
+    r.mul(at_least_1(t.set(ax[a].accel).div(dc[a]).mul(q).u32())).mul(m_->junction_dev_um);
     return r.mulc(kMilli, -41).u32(); // / 1000
 }
 
