@@ -145,7 +145,7 @@ uint32_t Planner::nominal2(const PlanBlock& b) {
     return speed2_of(b.feed);
 }
 
-PlanBlock* Planner::at(uint8_t i) {
+__attribute__((noinline)) PlanBlock* Planner::at(uint8_t i) {
     return &ring_[index(i)];
 }
 
@@ -386,13 +386,14 @@ MoveSpec Planner::spec_of_first() const {
 }
 
 uint32_t Planner::exit2_of_first() const {
-    return count_ > 1 ? ring_[index(1)].v_entry2 : 0;
+    return count_ > 1 ? const_cast<Planner*>(this)->at(1)->v_entry2 : 0;
 }
 
 void Planner::discard_first() {
     if (!count_) return;
     const PlanBlock& b = ring_[head_];
-    curve_used_ = static_cast<uint8_t>(curve_used_ & ~b.curve); // slot s: curve s + 1, bit s + 1
+    // Slot s is bit s + 1 of curve_used_ with two slots, i.e. the block's curve field.
+    curve_used_ = static_cast<uint8_t>(curve_used_ & ~b.curve);
     head_ = index(1);
     --count_;
     first_begun_ = 0;
