@@ -63,10 +63,15 @@ uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uin
 }
 
 // Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
-// of the plane's two axes bounds it (and the normal axis' when a helix moves it).
-uint32_t curve_accel(const Machine& m, const uint8_t ax[3], bool w_moves) {
+// of the plane's two axes bounds it (and the normal axis' when a helix moves it). The normal of
+// G17, G18, G19 is axis 2 - plane (plane_axes()).
+uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
+    uint8_t mask = w_moves ? 7 : static_cast<uint8_t>(7 ^ (4 >> plane));
     uint32_t acc = 0xFFFFFFFFul;
-    for (uint8_t k = 0; k < (w_moves ? 3 : 2); ++k) acc = min32(acc, m.settings->axis[ax[k]].accel);
+    const AxisSettings* ax = m.settings->axis;
+    for (uint8_t a = 0; a < 3; ++a, mask >>= 1) {
+        if (mask & 1) acc = min32(acc, ax[a].accel);
+    }
     return at_least_1(Num(acc).mul(18).div(5).u32()); // units/s^2 x1000 -> units/min^2
 }
 
@@ -308,7 +313,7 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
         feed = min32(feed,
                      t.set(st[ax[2]].max_rate).mul(shape.len_q8).div(abs32(dw_um)).shift(-8).u32());
     }
-    const uint32_t accel = curve_accel(*m_, ax, d[ax[2]] != 0);
+    const uint32_t accel = curve_accel(*m_, curve.plane, d[ax[2]] != 0);
     feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
     b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
@@ -373,9 +378,8 @@ MoveSpec Planner::spec_of_first() const {
         // dv2 saturated: the acceleration from the limits again.
         s.dv2 = 0;
         if (s.curve) {
-            uint8_t ax[3];
-            axes_of(s.curve->plane, ax);
-            s.accel = curve_accel(*m_, ax, s.delta[ax[2]] != 0);
+            const uint8_t plane = s.curve->plane;
+            s.accel = curve_accel(*m_, plane, s.delta[2 - plane] != 0);
         } else {
             MoveLimits lim;
             move_limits(*m_, s.delta, s.group, lim);
