@@ -62,16 +62,26 @@ uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uin
     return at_least_1(sum_squares(x, kAxes, group).sqrt().u32());
 }
 
-// Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
-// of the plane's two axes bounds it (and the normal axis' when a helix moves it). The normal of
-// G17, G18, G19 is axis 2 - plane (plane_axes()).
-uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
-    uint8_t mask = w_moves ? 7 : static_cast<uint8_t>(7 ^ (4 >> plane));
-    uint32_t acc = 0xFFFFFFFFul;
+// The smallest of a limit over the axes X, Y, Z whose bit is set in `mask`.
+__attribute__((noinline)) uint32_t min_over(const Machine& m, Limit which, uint8_t mask) {
+    uint32_t v = 0xFFFFFFFFul;
     const AxisSettings* ax = m.settings->axis;
     for (uint8_t a = 0; a < 3; ++a, mask >>= 1) {
-        if (mask & 1) acc = min32(acc, ax[a].accel);
+        if (mask & 1) v = min32(v, ax[a].*which);
     }
+    return v;
+}
+
+// The axes of a plane (plane_axes(): G17 X Y, G18 Z X, G19 Y Z), as a mask; its normal is axis
+// 2 - plane.
+uint8_t plane_mask(uint8_t plane) {
+    return static_cast<uint8_t>(7 ^ (4 >> plane));
+}
+
+// Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
+// of the plane's two axes bounds it (and the normal axis' when a helix moves it).
+uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
+    uint32_t acc = min_over(m, kAccel, w_moves ? 7 : plane_mask(plane));
     return at_least_1(Num(acc).mul(18).div(5).u32()); // units/s^2 x1000 -> units/min^2
 }
 
@@ -79,15 +89,6 @@ uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
 uint32_t speed2_of(uint32_t feed) {
     Num v(feed);
     return v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
-}
-
-// The axes of a plane as plane_axes() gives them, by rotation: ax[k] = (k - plane) mod 3.
-void axes_of(uint8_t plane, uint8_t ax[3]) {
-    uint8_t v = plane ? static_cast<uint8_t>(3 - plane) : 0;
-    for (uint8_t k = 0; k < 3; ++k) {
-        ax[k] = v;
-        v = v == 2 ? 0 : static_cast<uint8_t>(v + 1);
-    }
 }
 
 // Writes the 24-bit deltas of a block.
@@ -100,10 +101,15 @@ void pack(PlanBlock& b, const int32_t d[kAxes]) {
     }
 }
 
-// A curve's end tangent (u, v, w; w only when `n` is 3) as a machine-axis vector.
-void place(int32_t out[kAxes], const int32_t dir[3], const uint8_t ax[3], uint8_t n) {
+// A curve's end tangent (u, v, w; w only when `n` is 3) as a machine-axis vector. The axes of
+// the plane as plane_axes() gives them, by rotation: (u, v, w) = axes (k - plane) mod 3.
+void place(int32_t out[kAxes], const int32_t dir[3], uint8_t plane, uint8_t n) {
     for (uint8_t a = 0; a < kAxes; ++a) out[a] = 0;
-    for (uint8_t k = 0; k < n; ++k) out[ax[k]] = dir[k];
+    uint8_t a = plane ? static_cast<uint8_t>(3 - plane) : 0;
+    for (uint8_t k = 0; k < n; ++k) {
+        out[a] = dir[k];
+        a = a == 2 ? 0 : static_cast<uint8_t>(a + 1);
+    }
 }
 
 } // namespace
@@ -285,11 +291,12 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint32_t feed, uint32_t 
 
 bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                         const CurveParams& curve) {
-    uint8_t ax[3];
-    axes_of(curve.plane, ax);
-    const uint8_t group = m_->group_of[ax[0] < ax[1] ? ax[0] : ax[1]];
-    const uint8_t n = (group >> ax[2]) & 1 ? 3 : 2; // 3: the normal axis w is regulated
-    const int32_t dw_um = target_um[ax[2]] - last_um_[ax[2]];
+    const uint8_t plane = curve.plane;
+    const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
+    // The group of the plane's first machine axis (Y for G19, else X).
+    const uint8_t group = m_->group_of[plane == 2 ? 1 : 0];
+    const uint8_t n = (group >> w) & 1 ? 3 : 2; // 3: w is regulated
+    const int32_t dw_um = target_um[w] - last_um_[w];
     CurveShape shape;
     if (!curve_shape(curve, n == 3 ? dw_um : 0, n == 3, shape)) return false;
     // The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
@@ -306,20 +313,22 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L), and
     // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
     // sqrt(a r 1000) with a in units/min^2 and r in µm.
-    const AxisSettings* st = m_->settings->axis;
-    feed = min32(feed, min32(st[ax[0]].max_rate, st[ax[1]].max_rate));
+    feed = min32(feed, min_over(*m_, kRate, plane_mask(plane)));
     Num t;
     if (dw_um != 0) {
-        feed = min32(feed,
-                     t.set(st[ax[2]].max_rate).mul(shape.len_q8).div(abs32(dw_um)).shift(-8).u32());
+        feed = min32(feed, t.set(m_->settings->axis[w].max_rate)
+                               .mul(shape.len_q8)
+                               .div(abs32(dw_um))
+                               .shift(-8)
+                               .u32());
     }
-    const uint32_t accel = curve_accel(*m_, curve.plane, d[ax[2]] != 0);
+    const uint32_t accel = curve_accel(*m_, plane, d[w] != 0);
     feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
     b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
-    place(d, shape.start_dir, ax, n);
+    place(d, shape.start_dir, plane, n);
     finish_block(b, group, feed, shape.len_q8, d);
-    place(prev_unit_, shape.end_dir, ax, n);
+    place(prev_unit_, shape.end_dir, plane, n);
     return true;
 }
 
