@@ -269,7 +269,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
     b.curve = 0;
-    finish_block(b, group, rapid ? lim.vmax : min32(feed, lim.vmax), lim.len_q8, unit);
+    finish_block(b, group, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), lim.len_q8, unit);
     for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
     return true;
 }
@@ -279,11 +279,15 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint32_t feed, uint32_t 
     b.group = group;
     b.len_q8 = len_q8;
     b.feed = at_least_1(feed);
+    // From rest after no move or a move of another group; else the junction, within
     // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
-    uint32_t limit = count_ > 0 ? speed2_of(min32(b.feed, at(count_ - 1)->feed)) : 0;
-    uint32_t v_junction2 = prev_group_ == group && count_ > 0 ? junction2(unit_in, limit) : 0;
+    uint32_t v2 = 0;
+    if (count_ > 0 && prev_group_ == group) {
+        const uint32_t limit = speed2_of(min32(b.feed, at(count_ - 1)->feed));
+        v2 = min32(junction2(unit_in, limit), limit);
+    }
     prev_group_ = group;
-    b.v_max_entry2 = min32(v_junction2, limit);
+    b.v_max_entry2 = v2;
     b.v_entry2 = 0;
     ++count_;
     recalculate();
