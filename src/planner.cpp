@@ -268,15 +268,15 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (u > (1ul << 29)) u = 1ul << 29;
         unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
-    b.curve = 0;
-    finish_block(b, group, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), lim.len_q8, unit);
+    finish_block(b, group, 0, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), lim.len_q8, unit);
     for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
     return true;
 }
 
-void Planner::finish_block(PlanBlock& b, uint8_t group, uint32_t feed, uint32_t len_q8,
-                           const int32_t unit_in[kAxes]) {
-    b.group = group;
+void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
+                           uint32_t len_q8, const int32_t unit_in[kAxes]) {
+    b.group = group & 0x3F;
+    b.curve = curve & 3;
     b.len_q8 = len_q8;
     b.feed = at_least_1(feed);
     // From rest after no move or a move of another group; else the junction, within
@@ -309,7 +309,6 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     curve_used_ = static_cast<uint8_t>(curve_used_ | (slot + 1));
     curves_[slot] = curve;
     PlanBlock& b = *at(count_);
-    b.curve = static_cast<uint8_t>(slot + 1);
     int32_t d[kAxes];
     open(b, target, d);
     for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
@@ -331,7 +330,7 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
     place(d, shape.start_dir, plane, n);
-    finish_block(b, group, feed, shape.len_q8, d);
+    finish_block(b, group, static_cast<uint8_t>(slot + 1), feed, shape.len_q8, d);
     place(prev_unit_, shape.end_dir, plane, n);
     return true;
 }

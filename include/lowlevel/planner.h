@@ -3,9 +3,10 @@
 // from, recomputed as moves arrive (backward then forward pass). Speeds are squared, in
 // (units/min)^2 of each move's regulated path (seed §3.1); integer only.
 //
-// A queued move costs 33 bytes of RAM: deltas are kept on 24 bits; the length is kept (the step
-// generator needs it when the move starts, and recomputing it took a square root per move) and
-// the acceleration is derived from dv2 and the length instead of being stored.
+// A queued move costs 33 bytes of RAM (4 axes): deltas are kept on 24 bits, the group and the
+// curve slot share a byte; the length is kept (the step
+// generator needs it when the move starts, and recomputing it took a square root per move) and the
+// acceleration is derived from dv2 and the length instead of being stored.
 #pragma once
 
 #include "lowlevel/machine.h"
@@ -15,11 +16,12 @@ namespace ll {
 
 /// Curves queued at once (each keeps its geometry in a slot: RAM is the limit).
 constexpr uint8_t kCurveSlots = 2;
+static_assert(kAxes <= 6 && kCurveSlots <= 3, "a block's group and curve share one byte");
 
 struct PlanBlock {
     uint8_t delta[kAxes][3]; ///< steps per machine axis, signed 24-bit little-endian
-    uint8_t group;           ///< regulated axes (seed §3.1)
-    uint8_t curve;           ///< 0: a straight move; else 1 + the slot of its curve
+    uint8_t group : 6;       ///< regulated axes (seed §3.1)
+    uint8_t curve : 2;       ///< 0: a straight move; else 1 + the slot of its curve
     uint32_t feed;           ///< nominal speed, units/min x1000
     uint32_t len_q8;         ///< length of the regulated path, µm x 256 (for the step generator)
     uint32_t dv2;            ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
@@ -103,7 +105,7 @@ class Planner {
     /// Completes the block being queued (its deltas, curve and dv2 written): feed (at least 1),
     /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes. The
     /// caller then sets prev_unit_ to the direction it ends along.
-    void finish_block(PlanBlock& b, uint8_t group, uint32_t feed, uint32_t len_q8,
+    void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed, uint32_t len_q8,
                       const int32_t unit_in[kAxes]);
 
     const Machine* m_;
