@@ -4,9 +4,9 @@
 // (units/min)^2 of each move's regulated path (seed §3.1); integer only.
 //
 // A queued move costs 33 bytes of RAM (4 axes): deltas are kept on 24 bits, the group and the
-// curve slot share a byte; the length is kept (the step
-// generator needs it when the move starts, and recomputing it took a square root per move) and the
-// acceleration is derived from dv2 and the length instead of being stored.
+// curve slot share a byte; the length is kept (the step generator needs it when the move starts,
+// and recomputing it took a square root per move) and the acceleration is derived from dv2 and
+// the length instead of being stored.
 #pragma once
 
 #include "lowlevel/machine.h"
