@@ -145,7 +145,6 @@ void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
     count_ = 0;
     curve_used_ = 0;
     first_begun_ = 0;
-    prev_group_ = 0;
     for (uint8_t a = 0; a < kAxes; ++a) {
         last_[a] = steps[a];
         last_um_[a] = um[a];
@@ -279,14 +278,16 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t 
     b.curve = curve & 3;
     b.len_q8 = len_q8;
     b.feed = at_least_1(feed);
-    // From rest after no move or a move of another group; else the junction, within
+    // From rest after no queued move or one of another group; else the junction, within
     // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
     uint32_t v2 = 0;
-    if (count_ > 0 && prev_group_ == group) {
-        const uint32_t limit = speed2_of(min32(b.feed, at(count_ - 1)->feed));
-        v2 = min32(junction2(unit_in, limit), limit);
+    if (count_ > 0) {
+        const PlanBlock* prev = at(count_ - 1);
+        if (prev->group == group) {
+            const uint32_t limit = speed2_of(min32(b.feed, prev->feed));
+            v2 = min32(junction2(unit_in, limit), limit);
+        }
     }
-    prev_group_ = group;
     b.v_max_entry2 = v2;
     b.v_entry2 = 0;
     ++count_;

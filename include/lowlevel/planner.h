@@ -114,7 +114,6 @@ class Planner {
     uint8_t head_;
     uint8_t count_;
     uint8_t first_begun_; ///< the oldest move is in the step generator: its entry is fixed
-    uint8_t prev_group_;  ///< 0: no previous move (start from rest)
     int32_t last_[kAxes];
     int32_t last_um_[kAxes];
     int32_t prev_unit_[kAxes]; ///< unit vector of the last move, Q29
