@@ -418,9 +418,9 @@ void Planner::discard_first() {
 
 void Planner::restart_first(uint32_t remaining, uint32_t total) {
     if (!count_) return;
-    PlanBlock& b = ring_[head_];
-    if (total != 0) b.dv2 = Num(remaining).div(total).of(b.dv2);
-    b.v_entry2 = 0;
+    PlanBlock* const b = ring_ + head_;
+    if (total != 0) b->dv2 = Num(remaining).div(total).of(b->dv2);
+    b->v_entry2 = 0;
     first_begun_ = 1;
     recalculate(true);
 }
