@@ -108,15 +108,17 @@ class Planner {
     void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed, uint32_t len_q8,
                       const int32_t unit_in[kAxes]);
 
+    // The small fields first: within 64 bytes of `this`, the ATmega328P reaches them with one
+    // displacement instruction instead of an address computation.
     const Machine* m_;
-    uint8_t curve_used_; ///< bit i: curves_[i] belongs to a queued move
-    CurveParams curves_[kCurveSlots];
     uint8_t head_;
     uint8_t count_;
     uint8_t first_begun_; ///< the oldest move is in the step generator: its entry is fixed
+    uint8_t curve_used_;  ///< bit i: curves_[i] belongs to a queued move
     int32_t last_[kAxes];
     int32_t last_um_[kAxes];
     int32_t prev_unit_[kAxes]; ///< unit vector of the last move, Q29
+    CurveParams curves_[kCurveSlots];
     PlanBlock ring_[kPlannerSize];
 };
 
