@@ -91,16 +91,6 @@ uint32_t speed2_of(uint32_t feed) {
     return v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
 }
 
-// Writes the 24-bit deltas of a block.
-void pack(PlanBlock& b, const int32_t d[kAxes]) {
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        uint32_t v = static_cast<uint32_t>(d[a]);
-        b.delta[a][0] = static_cast<uint8_t>(v);
-        b.delta[a][1] = static_cast<uint8_t>(v >> 8);
-        b.delta[a][2] = static_cast<uint8_t>(v >> 16);
-    }
-}
-
 // A curve's end tangent (u, v, w; w only when `n` is 3) as a machine-axis vector. The axes of
 // the plane as plane_axes() gives them, by rotation: (u, v, w) = axes (k - plane) mod 3.
 void place(int32_t out[kAxes], const int32_t dir[3], uint8_t plane, uint8_t n) {
@@ -217,12 +207,16 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
 
 bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) {
     bool moves = false;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        d[a] = target[a] - last_[a];
+    uint8_t* p = b.delta[0];
+    for (uint8_t a = 0; a < kAxes; ++a, p += 3) {
+        const uint32_t v = static_cast<uint32_t>(target[a] - last_[a]);
         last_[a] = target[a];
-        if (d[a] != 0) moves = true;
+        d[a] = static_cast<int32_t>(v);
+        if (v != 0) moves = true;
+        p[0] = static_cast<uint8_t>(v);
+        p[1] = static_cast<uint8_t>(v >> 8);
+        p[2] = static_cast<uint8_t>(v >> 16);
     }
-    pack(b, d);
     return moves;
 }
 
