@@ -235,9 +235,9 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         }
         group = regulated_group(*m_, d);
         move_limits(*m_, d, group, lim);
-        // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000.
-        uint32_t lo, hi = mul_wide(lim.len_q8, lim.accel, lo);
-        b.dv2 = num64(hi, lo).mulc(kMilli, -48).u32();
+        // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000. Num::mul() keeps the top 32 bits
+        // of the exact product, as num64(mul_wide()) would.
+        b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
     }
 
     // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
