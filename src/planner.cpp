@@ -1,5 +1,8 @@
 #include "lowlevel/planner.h"
 
+#include <stddef.h>
+#include <string.h>
+
 namespace ll {
 namespace {
 
@@ -373,14 +376,18 @@ MoveSpec Planner::spec_of_first() const {
     MoveSpec s;
     for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(*b, a);
     s.len_q8 = b->len_q8;
-    s.feed = b->feed;
-    s.v_entry2 = b->v_entry2;
+    // dv2 (the profile from the planner's own 2 a L), feed, v_entry2: one copy.
+    static_assert(offsetof(MoveSpec, feed) == offsetof(MoveSpec, dv2) + 4 &&
+                      offsetof(MoveSpec, v_entry2) == offsetof(MoveSpec, dv2) + 8 &&
+                      offsetof(PlanBlock, feed) == offsetof(PlanBlock, dv2) + 4 &&
+                      offsetof(PlanBlock, v_entry2) == offsetof(PlanBlock, dv2) + 8,
+                  "dv2, feed, v_entry2 in the same order");
+    memcpy(&s.dv2, &b->dv2, 12);
     s.group = b->group;
     s.v_nominal2 = nominal2(*b);
     s.v_exit2 = exit2_of_first();
     s.curve = b->curve ? &curves_[b->curve - 1] : nullptr;
     s.accel = 0;
-    s.dv2 = b->dv2; // the profile from the planner's own 2 a L
     if (s.dv2 == 0xFFFFFFFFul) {
         // dv2 saturated: the acceleration from the limits again.
         s.dv2 = 0;

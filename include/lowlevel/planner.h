@@ -22,11 +22,12 @@ struct PlanBlock {
     uint8_t delta[kAxes][3]; ///< steps per machine axis, signed 24-bit little-endian
     uint8_t group : 6;       ///< regulated axes (seed §3.1)
     uint8_t curve : 2;       ///< 0: a straight move; else 1 + the slot of its curve
-    uint32_t feed;           ///< nominal speed, units/min x1000
     uint32_t len_q8;         ///< length of the regulated path, µm x 256 (for the step generator)
-    uint32_t dv2;            ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
-    uint32_t v_entry2;       ///< planned entry speed squared
-    uint32_t v_max_entry2;   ///< junction and nominal limit on the entry speed squared
+    // dv2, feed, v_entry2: in MoveSpec's order (spec_of_first() copies them at once).
+    uint32_t dv2;          ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
+    uint32_t feed;         ///< nominal speed, units/min x1000
+    uint32_t v_entry2;     ///< planned entry speed squared
+    uint32_t v_max_entry2; ///< junction and nominal limit on the entry speed squared
 };
 
 /// Length, acceleration and speed limit of a move along its regulated path (every axis, in
