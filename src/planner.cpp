@@ -138,10 +138,8 @@ void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
     count_ = 0;
     curve_used_ = 0;
     first_begun_ = 0;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        last_[a] = steps[a];
-        last_um_[a] = um[a];
-    }
+    memcpy(last_, steps, sizeof(last_));
+    memcpy(last_um_, um, sizeof(last_um_));
 }
 
 uint32_t Planner::nominal2(const PlanBlock& b) {
@@ -233,7 +231,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     {
         int32_t d[kAxes];
         if (!open(b, target, d)) {
-            for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
+            memcpy(last_um_, target_um, sizeof(last_um_));
             return false;
         }
         group = regulated_group(*m_, d);
@@ -309,7 +307,7 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     PlanBlock& b = *at(count_);
     int32_t d[kAxes];
     open(b, target, d);
-    for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
+    memcpy(last_um_, target_um, sizeof(last_um_));
     // Speed: the requested feed, within the plane axes' rates (the tangent takes every
     // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L), and
     // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
