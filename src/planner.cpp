@@ -97,7 +97,7 @@ uint32_t speed2_of(uint32_t feed) {
 // A curve's end tangent (u, v, w; w only when `n` is 3) as a machine-axis vector. The axes of
 // the plane as plane_axes() gives them, by rotation: (u, v, w) = axes (k - plane) mod 3.
 void place(int32_t out[kAxes], const int32_t dir[3], uint8_t plane, uint8_t n) {
-    for (uint8_t a = 0; a < kAxes; ++a) out[a] = 0;
+    memset(out, 0, kAxes * sizeof(int32_t));
     uint8_t a = plane ? static_cast<uint8_t>(3 - plane) : 0;
     for (uint8_t k = 0; k < n; ++k) {
         out[a] = dir[k];
