@@ -110,20 +110,23 @@ void place(int32_t out[kAxes], const int32_t dir[3], uint8_t plane, uint8_t n) {
 void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out) {
     uint32_t x[kAxes];
     out.len_q8 = travel(m, delta, group, x);
-    // limit_along() for both limits, sharing len / x[a] when one axis bounds both (the common
-    // case): one division.
+    // limit_along() for the rate, then the acceleration, sharing len / x[a] when one axis bounds
+    // both (the common case): one division.
     const AxisSettings* ax = m.settings->axis;
-    uint8_t ar = tightest(ax, kRate, x), aa = tightest(ax, kAccel, x);
-    if (ar == kAxes) {
-        out.vmax = out.accel = 0xFFFFFFFFul; // nothing moves
-        return;
+    Num r;
+    uint8_t prev = kAxes;
+    for (uint8_t k = 0; k < 2; ++k) {
+        const Limit which = k ? kAccel : kRate;
+        const uint8_t a = tightest(ax, which, x);
+        uint32_t v = 0xFFFFFFFFul; // nothing moves
+        if (a != kAxes) {
+            if (a != prev) r.set(out.len_q8).div(x[a]);
+            prev = a;
+            if (k) r.mulc(k3_6, k3_6e); // units/s^2 x1000 -> units/min^2
+            v = at_least_1(r.of(ax[a].*which));
+        }
+        (k ? out.accel : out.vmax) = v;
     }
-    Num r(out.len_q8);
-    r.div(x[ar]);
-    out.vmax = at_least_1(r.of(ax[ar].max_rate));
-    if (aa != ar) r.set(out.len_q8).div(x[aa]);
-    // units/s^2 x1000 -> units/min^2
-    out.accel = at_least_1(r.mulc(k3_6, k3_6e).of(ax[aa].accel));
 }
 
 int32_t Planner::delta(const PlanBlock& b, uint8_t axis) {
