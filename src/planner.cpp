@@ -129,13 +129,6 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
     }
 }
 
-int32_t Planner::delta(const PlanBlock& b, uint8_t axis) {
-    const uint8_t* d = b.delta[axis];
-    uint32_t v = d[0] | static_cast<uint32_t>(d[1]) << 8 | static_cast<uint32_t>(d[2]) << 16;
-    if (v & 0x800000ul) v |= 0xFF000000ul; // sign extension
-    return static_cast<int32_t>(v);
-}
-
 void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
     head_ = 0;
     count_ = 0;

@@ -88,7 +88,13 @@ class Planner {
 
     /// Nominal speed squared of a move, (units/min)^2.
     static uint32_t nominal2(const PlanBlock& b);
-    static int32_t delta(const PlanBlock& b, uint8_t axis);
+    /// Steps of a move along an axis (its 24-bit delta, sign-extended).
+    static int32_t delta(const PlanBlock& b, uint8_t axis) {
+        const uint8_t* d = b.delta[axis];
+        uint32_t v = d[0] | static_cast<uint32_t>(d[1]) << 8 | static_cast<uint32_t>(d[2]) << 16;
+        if (v & 0x800000ul) v |= 0xFF000000ul; // sign extension
+        return static_cast<int32_t>(v);
+    }
 
   private:
     uint8_t index(uint8_t i) const { return static_cast<uint8_t>((head_ + i) % kPlannerSize); }
