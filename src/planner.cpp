@@ -378,7 +378,7 @@ MoveSpec Planner::spec_of_first() const {
                   "dv2, feed, v_entry2 in the same order");
     memcpy(&s.dv2, &b->dv2, 12);
     s.group = b->group;
-    s.v_nominal2 = nominal2(*b);
+    s.v_nominal2 = speed2_of(s.feed);
     s.v_exit2 = exit2_of_first();
     s.curve = b->curve ? &curves_[b->curve - 1] : nullptr;
     s.accel = 0;
