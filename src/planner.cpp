@@ -19,7 +19,8 @@ constexpr Limit kAccel = &AxisSettings::accel;
 
 // v, at least 1 (speeds and accelerations are divisors downstream).
 __attribute__((noinline)) uint32_t at_least_1(uint32_t v) {
-    return v ? v : 1;
+    if (!v) v = 1;
+    return v;
 }
 
 // Normalised constants for Num::mulc().
