@@ -329,7 +329,7 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
 }
 
 void Planner::recalculate(bool all) {
-    // Pointer walks (an index modulo the ring and a 34-byte stride per block cost more than the
+    // Pointer walks (an index modulo the ring and a 33-byte stride per block cost more than the
     // passes themselves on the ATmega328P).
     PlanBlock* const first = ring_;
     PlanBlock* const last = ring_ + (kPlannerSize - 1);
