@@ -292,7 +292,8 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
     // The group of the plane's first machine axis (Y for G19, else X).
     const uint8_t group = m_->group_of[plane == 2 ? 1 : 0];
-    const uint8_t n = (group >> w) & 1 ? 3 : 2; // 3: w is regulated
+    const uint8_t in_plane = plane_mask(plane);
+    const uint8_t n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated
     const int32_t dw_um = target_um[w] - last_um_[w];
     CurveShape shape;
     if (!curve_shape(curve, n == 3 ? dw_um : 0, n == 3, shape)) return false;
@@ -309,7 +310,7 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L), and
     // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
     // sqrt(a r 1000) with a in units/min^2 and r in µm.
-    feed = min32(feed, min_over(*m_, kRate, plane_mask(plane)));
+    feed = min32(feed, min_over(*m_, kRate, in_plane));
     Num t;
     if (dw_um != 0) {
         feed = min32(feed, t.set(m_->settings->axis[w].max_rate)
