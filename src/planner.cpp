@@ -1,5 +1,8 @@
 #include "lowlevel/planner.h"
 
+#include <stddef.h>
+#include <string.h>
+
 namespace ll {
 namespace {
 
@@ -7,11 +10,17 @@ uint32_t min32(uint32_t a, uint32_t b) {
     return a < b ? a : b;
 }
 
-// The per-axis limits, read straight from the settings: maximum rates (units/min x1000) and
-// accelerations (units/s^2 x1000, which scale to units/min^2 by x3.6).
-enum Limit : uint8_t { kRate = 0, kAccel = 1 };
-uint32_t axis_limit(const Settings& s, uint8_t a, Limit which) {
-    return which == kRate ? s.axis[a].max_rate : s.axis[a].accel;
+// The per-axis limits are read straight from the settings: maximum rates (units/min x1000) and
+// accelerations (units/s^2 x1000, which scale to units/min^2 by x3.6), one field of AxisSettings
+// chosen by a member pointer (an offset: one loop serves both).
+using Limit = uint32_t AxisSettings::*;
+constexpr Limit kRate = &AxisSettings::max_rate;
+constexpr Limit kAccel = &AxisSettings::accel;
+
+// v, at least 1 (speeds and accelerations are divisors downstream).
+__attribute__((noinline)) uint32_t at_least_1(uint32_t v) {
+    if (!v) v = 1;
+    return v;
 }
 
 // Normalised constants for Num::mulc().
@@ -30,93 +39,55 @@ bool ratio_less(uint32_t n1, uint32_t d1, uint32_t n2, uint32_t d2) {
 
 // The axis with comp[a] > 0 whose lim[a] / comp[a] is the smallest (the first one on a tie),
 // kAxes when every comp[a] is 0.
-uint8_t tightest(const Settings& s, Limit which, const uint32_t comp[kAxes]) {
+uint8_t tightest(const AxisSettings* ax, Limit which, const uint32_t comp[kAxes]) {
     uint8_t best = kAxes;
+    uint32_t best_lim = 0, best_comp = 0;
     for (uint8_t a = 0; a < kAxes; ++a) {
-        if (comp[a] == 0) continue;
-        if (best == kAxes ||
-            ratio_less(axis_limit(s, a, which), comp[a], axis_limit(s, best, which), comp[best])) {
+        const uint32_t c = comp[a], lim = ax[a].*which;
+        if (c == 0) continue;
+        if (best == kAxes || ratio_less(lim, c, best_lim, best_comp)) {
             best = a;
+            best_lim = lim;
+            best_comp = c;
         }
     }
     return best;
 }
 
 // x <= 5e-7 (GRBL's junction thresholds): 5e-7 = kMicro 2^-52.
-bool tiny(const Num& x) {
+__attribute__((noinline)) bool tiny(const Num& x) {
     return x.m == 0 || x.e < -52 || (x.e == -52 && x.m <= kMicro);
 }
-
-// Euclidean norm of kAxes 32-bit components.
-Num norm(const uint32_t v[kAxes]) {
-    return sum_squares(v, kAxes).sqrt();
-}
-
-} // namespace
-
-namespace {
 
 // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated length:
 // Euclidean over the move's group (seed §3.1), at least 1.
 uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uint32_t x[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
-    uint32_t len = sum_squares(x, kAxes, group).sqrt().u32();
-    return len ? len : 1;
+    return at_least_1(sum_squares(x, kAxes, group).sqrt().u32());
+}
+
+// The smallest of a limit over the axes X, Y, Z whose bit is set in `mask`.
+__attribute__((noinline)) uint32_t min_over(const Machine& m, Limit which, uint8_t mask) {
+    uint32_t v = 0xFFFFFFFFul;
+    const AxisSettings* ax = m.settings->axis;
+    for (uint8_t a = 0; a < 3; ++a, mask >>= 1) {
+        if (mask & 1) v = min32(v, ax[a].*which);
+    }
+    return v;
+}
+
+// The axes of a plane (plane_axes(): G17 X Y, G18 Z X, G19 Y Z), as a mask; its normal is axis
+// 2 - plane.
+uint8_t plane_mask(uint8_t plane) {
+    return static_cast<uint8_t>(7 ^ (4 >> plane));
 }
 
 // Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
 // of the plane's two axes bounds it (and the normal axis' when a helix moves it).
 uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
-    uint8_t ax[3];
-    plane_axes(plane, ax);
-    uint32_t acc = 0xFFFFFFFFul;
-    for (uint8_t k = 0; k < (w_moves ? 3 : 2); ++k) acc = min32(acc, m.settings->axis[ax[k]].accel);
-    uint32_t v = Num(acc).mul(18).div(5).u32(); // units/s^2 x1000 -> units/min^2
-    return v ? v : 1;
+    uint32_t acc = min_over(m, kAccel, w_moves ? 7 : plane_mask(plane));
+    return at_least_1(Num(acc).mul(18).div(5).u32()); // units/s^2 x1000 -> units/min^2
 }
-
-} // namespace
-
-void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out) {
-    uint32_t x[kAxes];
-    out.len_q8 = travel(m, delta, group, x);
-    // limit_along() for both limits, sharing len / x[a] when one axis bounds both (the common
-    // case): one division.
-    const Settings& s = *m.settings;
-    uint8_t ar = tightest(s, kRate, x), aa = tightest(s, kAccel, x);
-    if (ar == kAxes) {
-        out.vmax = out.accel = 0xFFFFFFFFul; // nothing moves
-        return;
-    }
-    Num r(out.len_q8);
-    r.div(x[ar]);
-    uint32_t v = r.of(s.axis[ar].max_rate);
-    out.vmax = v ? v : 1;
-    if (aa != ar) r.set(out.len_q8).div(x[aa]);
-    v = r.mulc(k3_6, k3_6e).of(s.axis[aa].accel); // units/s^2 x1000 -> units/min^2
-    out.accel = v ? v : 1;
-}
-
-int32_t Planner::delta(const PlanBlock& b, uint8_t axis) {
-    const uint8_t* d = b.delta[axis];
-    uint32_t v = d[0] | static_cast<uint32_t>(d[1]) << 8 | static_cast<uint32_t>(d[2]) << 16;
-    if (v & 0x800000ul) v |= 0xFF000000ul; // sign extension
-    return static_cast<int32_t>(v);
-}
-
-void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
-    head_ = 0;
-    count_ = 0;
-    curve_used_ = 0;
-    first_begun_ = 0;
-    prev_group_ = 0;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        last_[a] = steps[a];
-        last_um_[a] = um[a];
-    }
-}
-
-namespace {
 
 // Squared speed of a feed (units/min x1000), (units/min)^2.
 uint32_t speed2_of(uint32_t feed) {
@@ -124,10 +95,56 @@ uint32_t speed2_of(uint32_t feed) {
     return v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
 }
 
+// A curve's end tangent (u, v, w; w only when `n` is 3) as a machine-axis vector. The axes of
+// the plane as plane_axes() gives them, by rotation: (u, v, w) = axes (k - plane) mod 3.
+void place(int32_t out[kAxes], const int32_t dir[3], uint8_t plane, uint8_t n) {
+    memset(out, 0, kAxes * sizeof(int32_t));
+    uint8_t a = plane ? static_cast<uint8_t>(3 - plane) : 0;
+    for (uint8_t k = 0; k < n; ++k) {
+        out[a] = dir[k];
+        a = a == 2 ? 0 : static_cast<uint8_t>(a + 1);
+    }
+}
+
 } // namespace
+
+void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out) {
+    uint32_t x[kAxes];
+    out.len_q8 = travel(m, delta, group, x);
+    // limit_along() for the rate, then the acceleration, sharing len / x[a] when one axis bounds
+    // both (the common case): one division.
+    const AxisSettings* ax = m.settings->axis;
+    Num r;
+    uint8_t prev = kAxes;
+    for (uint8_t k = 0; k < 2; ++k) {
+        const Limit which = k ? kAccel : kRate;
+        const uint8_t a = tightest(ax, which, x);
+        uint32_t v = 0xFFFFFFFFul; // nothing moves
+        if (a != kAxes) {
+            if (a != prev) r.set(out.len_q8).div(x[a]);
+            prev = a;
+            if (k) r.mulc(k3_6, k3_6e); // units/s^2 x1000 -> units/min^2
+            v = at_least_1(r.of(ax[a].*which));
+        }
+        (k ? out.accel : out.vmax) = v;
+    }
+}
+
+void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
+    head_ = 0;
+    count_ = 0;
+    curve_used_ = 0;
+    first_begun_ = 0;
+    memcpy(last_, steps, sizeof(last_));
+    memcpy(last_um_, um, sizeof(last_um_));
+}
 
 uint32_t Planner::nominal2(const PlanBlock& b) {
     return speed2_of(b.feed);
+}
+
+__attribute__((noinline)) PlanBlock* Planner::at(uint8_t i) {
+    return &ring_[index(i)];
 }
 
 // Junction speed squared with the previous move (GRBL's junction deviation, $11), from the
@@ -140,13 +157,15 @@ uint32_t Planner::nominal2(const PlanBlock& b) {
 uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     uint32_t dc[kAxes];
     uint32_t a_min = 0xFFFFFFFFul;
-    const Settings& s = *m_->settings;
+    const AxisSettings* ax = m_->settings->axis;
     for (uint8_t a = 0; a < kAxes; ++a) {
         dc[a] = abs32(unit[a] - prev_unit_[a]); // <= 2^30
-        if (dc[a] != 0 && s.axis[a].accel < a_min) a_min = s.axis[a].accel;
+        if (dc[a] != 0) a_min = min32(a_min, ax[a].accel);
     }
-    Num q = sum_squares(dc, kAxes); // |d|^2 / 4
-    q.shift(-60);
+    // |d|^2 / 4. Exponents are adjusted in place below (no Num::shift()): a zero stays zero
+    // whatever its exponent.
+    Num q = sum_squares(dc, kAxes);
+    q.e = static_cast<int8_t>(q.e - 60);
     // GRBL's thresholds: |cos theta| > 0.999999 is straight on (no limit) or a reversal
     // (stop), i.e. q or p below 5e-7.
     if (tiny(q)) return 0xFFFFFFFFul;
@@ -156,66 +175,67 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     //   v_junction^2 >= a_min x 3.6 x delta / (2000 q) >= limit  when  a_min delta >= 1024 q limit
     // (a margin of 1.8 over every truncation below): then the junction does not limit.
     // Nearly straight chains of short segments (the common case) stop here.
+    Num t, r;
     if (q.e < -32) {
-        Num lhs(a_min);
-        Num rhs(limit);
-        if (lhs.mul(m_->junction_dev_um).cmp(rhs.mul(q).shift(10)) >= 0) return 0xFFFFFFFFul;
+        t.set(a_min).mul(m_->junction_dev_um);
+        r.set(limit).mul(q);
+        r.e = static_cast<int8_t>(r.e + 10);
+        if (t.cmp(r) >= 0) return 0xFFFFFFFFul;
     }
     // The exact formula (rare in chains of short segments).
     // p = 1 - q to 2^-32: near a reversal (p small) its relative error grows to 2^-11 at the
     // 5e-7 threshold, where v_junction^2 is a few (mm/min)^2, well within a unit.
-    Num t = q;
-    t.set(~t.shift(32).u32(), -32);
+    q.e = static_cast<int8_t>(q.e + 32);
+    t.set(~q.u32(), -32);
+    q.e = static_cast<int8_t>(q.e - 32);
     if (tiny(t)) return 0;
-    Num r(1);
-    t.sqrt();               // sin(theta / 2)
-    r.add(t).mul(t).div(q); // (1 + sin) sin / q
+    t.sqrt();                      // sin(theta / 2)
+    r.set(1).add(t).mul(t).div(q); // (1 + sin) sin / q
     // Acceleration along the junction vector d, limited per axis (GRBL's
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
     // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
     // 1000.
-    uint8_t a = tightest(s, kAccel, dc);
-    t = q;
-    t.sqrt().shift(30).mulc(k3_6, k3_6e);
-    uint32_t ja = Num(s.axis[a].accel).div(dc[a]).mul(t).u32();
-    r.mul(ja ? ja : 1).mul(m_->junction_dev_um);
+    uint8_t a = tightest(ax, kAccel, dc);
+    q.sqrt();
+    q.e = static_cast<int8_t>(q.e + 30);
+    q.mulc(k3_6, k3_6e);
+    r.mul(at_least_1(t.set(ax[a].accel).div(dc[a]).mul(q).u32())).mul(m_->junction_dev_um);
     return r.mulc(kMilli, -41).u32(); // / 1000
+}
+
+bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) {
+    bool moves = false;
+    uint8_t* p = b.delta[0];
+    for (uint8_t a = 0; a < kAxes; ++a, p += 3) {
+        const uint32_t v = static_cast<uint32_t>(target[a] - last_[a]);
+        last_[a] = target[a];
+        d[a] = static_cast<int32_t>(v);
+        if (v != 0) moves = true;
+        p[0] = static_cast<uint8_t>(v);
+        p[1] = static_cast<uint8_t>(v >> 8);
+        p[2] = static_cast<uint8_t>(v >> 16);
+    }
+    return moves;
 }
 
 bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                   bool rapid) {
     // Few locals, in scopes that do not overlap (they share their stack slots): the deepest
     // stack of the firmware runs through here.
-    PlanBlock& b = ring_[index(count_)];
+    PlanBlock& b = *at(count_);
     uint8_t group;
+    MoveLimits lim;
     {
         int32_t d[kAxes];
-        bool moves = false;
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            d[a] = target[a] - last_[a];
-            if (d[a] != 0) moves = true;
-        }
-        if (!moves) {
-            for (uint8_t a = 0; a < kAxes; ++a) last_um_[a] = target_um[a];
+        if (!open(b, target, d)) {
+            memcpy(last_um_, target_um, sizeof(last_um_));
             return false;
         }
-        for (uint8_t a = 0; a < kAxes; ++a) {
-            last_[a] = target[a];
-            uint32_t v = static_cast<uint32_t>(d[a]);
-            b.delta[a][0] = static_cast<uint8_t>(v);
-            b.delta[a][1] = static_cast<uint8_t>(v >> 8);
-            b.delta[a][2] = static_cast<uint8_t>(v >> 16);
-        }
         group = regulated_group(*m_, d);
-        b.group = group;
-        MoveLimits lim;
         move_limits(*m_, d, group, lim);
-        b.len_q8 = lim.len_q8;
-        b.feed = rapid || feed > lim.vmax ? lim.vmax : feed;
-        if (b.feed == 0) b.feed = 1;
-        // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000.
-        uint32_t lo, hi = mul_wide(lim.len_q8, lim.accel, lo);
-        b.dv2 = num64(hi, lo).mulc(kMilli, -48).u32();
+        // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000. Num::mul() keeps the top 32 bits
+        // of the exact product, as num64(mul_wide()) would.
+        b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
     }
 
     // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
@@ -230,27 +250,37 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (du < 0) neg = static_cast<uint8_t>(neg | bit);
         xu[a] = (in_group & 1) ? abs32(du) : 0;
     }
+    Num n = sum_squares(xu, kAxes);
     Num to_unit(1, 29);
-    to_unit.div(norm(xu));
+    to_unit.div(n.sqrt());
     int32_t* unit = reinterpret_cast<int32_t*>(xu);
     for (uint8_t a = 0; a < kAxes; ++a, neg >>= 1) {
         uint32_t u = to_unit.of(xu[a]);
         if (u > (1ul << 29)) u = 1ul << 29;
         unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
-    b.curve = 0;
-    finish_block(b, unit, unit);
+    finish_block(b, group, 0, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), lim.len_q8, unit);
+    for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
     return true;
 }
 
-void Planner::finish_block(PlanBlock& b, const int32_t unit_in[kAxes],
-                           const int32_t unit_out[kAxes]) {
+void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
+                           uint32_t len_q8, const int32_t unit_in[kAxes]) {
+    b.group = group & 0x3F;
+    b.curve = curve & 3;
+    b.len_q8 = len_q8;
+    b.feed = at_least_1(feed);
+    // From rest after no queued move or one of another group; else the junction, within
     // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
-    uint32_t limit = count_ > 0 ? speed2_of(min32(b.feed, ring_[index(count_ - 1)].feed)) : 0;
-    uint32_t v_junction2 = prev_group_ == b.group && count_ > 0 ? junction2(unit_in, limit) : 0;
-    for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit_out[a];
-    prev_group_ = b.group;
-    b.v_max_entry2 = min32(v_junction2, limit);
+    uint32_t v2 = 0;
+    if (count_ > 0) {
+        const PlanBlock* prev = at(count_ - 1);
+        if (prev->group == group) {
+            const uint32_t limit = speed2_of(min32(b.feed, prev->feed));
+            v2 = min32(junction2(unit_in, limit), limit);
+        }
+    }
+    b.v_max_entry2 = v2;
     b.v_entry2 = 0;
     ++count_;
     recalculate();
@@ -258,55 +288,44 @@ void Planner::finish_block(PlanBlock& b, const int32_t unit_in[kAxes],
 
 bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                         const CurveParams& curve) {
-    uint8_t ax[3];
-    plane_axes(curve.plane, ax);
-    int32_t d[kAxes];
-    for (uint8_t a = 0; a < kAxes; ++a) d[a] = target[a] - last_[a];
-    const uint8_t group = m_->group_of[ax[0] < ax[1] ? ax[0] : ax[1]];
-    const bool w_reg = (group & (1u << ax[2])) != 0;
-    const int32_t dw_um = target_um[ax[2]] - last_um_[ax[2]];
+    const uint8_t plane = curve.plane;
+    const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
+    // The group of the plane's first machine axis (Y for G19, else X).
+    const uint8_t group = m_->group_of[plane == 2 ? 1 : 0];
+    const uint8_t in_plane = plane_mask(plane);
+    const uint8_t n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated
+    const int32_t dw_um = target_um[w] - last_um_[w];
     CurveShape shape;
-    if (!curve_shape(curve, w_reg ? dw_um : 0, w_reg, shape)) return false;
-    uint8_t slot = 0;
-    while (curve_used_ & (1u << slot)) ++slot;
-    curve_used_ = static_cast<uint8_t>(curve_used_ | (1u << slot));
+    if (!curve_shape(curve, n == 3 ? dw_um : 0, n == 3, shape)) return false;
+    // The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
+    static_assert(kCurveSlots == 2, "one free slot out of two");
+    const uint8_t slot = curve_used_ & 1;
+    curve_used_ = static_cast<uint8_t>(curve_used_ | (slot + 1));
     curves_[slot] = curve;
-    PlanBlock& b = ring_[index(count_)];
-    b.curve = static_cast<uint8_t>(slot + 1);
-    b.len_q8 = shape.len_q8;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        last_[a] = target[a];
-        last_um_[a] = target_um[a];
-        uint32_t v = static_cast<uint32_t>(d[a]);
-        b.delta[a][0] = static_cast<uint8_t>(v);
-        b.delta[a][1] = static_cast<uint8_t>(v >> 8);
-        b.delta[a][2] = static_cast<uint8_t>(v >> 16);
-    }
-    b.group = group;
+    PlanBlock& b = *at(count_);
+    int32_t d[kAxes];
+    open(b, target, d);
+    memcpy(last_um_, target_um, sizeof(last_um_));
     // Speed: the requested feed, within the plane axes' rates (the tangent takes every
     // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L), and
     // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
     // sqrt(a r 1000) with a in units/min^2 and r in µm.
-    const Settings& st = *m_->settings;
-    uint32_t vmax = min32(st.axis[ax[0]].max_rate, st.axis[ax[1]].max_rate);
+    feed = min32(feed, min_over(*m_, kRate, in_plane));
+    Num t;
     if (dw_um != 0) {
-        uint32_t vw =
-            Num(st.axis[ax[2]].max_rate).mul(shape.len_q8).div(abs32(dw_um)).shift(-8).u32();
-        vmax = min32(vmax, vw);
+        feed = min32(feed, t.set(m_->settings->axis[w].max_rate)
+                               .mul(shape.len_q8)
+                               .div(abs32(dw_um))
+                               .shift(-8)
+                               .u32());
     }
-    const uint32_t accel = curve_accel(*m_, curve.plane, d[ax[2]] != 0);
-    vmax = min32(vmax, Num(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
-    b.feed = min32(feed, vmax);
-    if (b.feed == 0) b.feed = 1;
-    b.dv2 = Num(shape.len_q8).mul(accel).div(128000).u32();
+    const uint32_t accel = curve_accel(*m_, plane, d[w] != 0);
+    feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
+    b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
-    int32_t in[kAxes] = {}, out[kAxes] = {};
-    for (uint8_t k = 0; k < 3; ++k) {
-        if (k == 2 && !w_reg) continue;
-        in[ax[k]] = shape.start_dir[k];
-        out[ax[k]] = shape.end_dir[k];
-    }
-    finish_block(b, in, out);
+    place(d, shape.start_dir, plane, n);
+    finish_block(b, group, static_cast<uint8_t>(slot + 1), feed, shape.len_q8, d);
+    place(prev_unit_, shape.end_dir, plane, n);
     return true;
 }
 
@@ -322,7 +341,7 @@ void Planner::recalculate(bool all) {
     // keeps its entry: the passes stop there (in a chain of short moves, a few moves from the
     // end instead of the whole ring). Only while the oldest move is being executed: its entry
     // is then fixed, as it was at the last pass; otherwise it is recomputed from scratch.
-    PlanBlock* b = &ring_[index(static_cast<uint8_t>(count_ - 1))];
+    PlanBlock* b = at(static_cast<uint8_t>(count_ - 1));
     uint32_t next_entry = 0;
     uint8_t pos = count_;
     uint8_t from = 0; // where the forward pass starts
@@ -340,7 +359,7 @@ void Planner::recalculate(bool all) {
         b = b == first ? last : b - 1;
     }
     // Forward pass: no move can enter faster than the previous one can accelerate to.
-    b = &ring_[index(from)];
+    b = at(from);
     for (uint8_t n = static_cast<uint8_t>(count_ - from); n > 1; --n) {
         uint32_t reach = add_sat(b->v_entry2, b->dv2);
         b = b == last ? first : b + 1;
@@ -349,42 +368,46 @@ void Planner::recalculate(bool all) {
 }
 
 MoveSpec Planner::spec_of_first() const {
-    const PlanBlock& b = ring_[head_];
+    const PlanBlock* const b = ring_ + head_;
     MoveSpec s;
-    for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(b, a);
-    s.len_q8 = b.len_q8;
+    for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(*b, a);
+    s.len_q8 = b->len_q8;
+    // dv2 (the profile from the planner's own 2 a L), feed, v_entry2: one copy.
+    static_assert(offsetof(MoveSpec, feed) == offsetof(MoveSpec, dv2) + 4 &&
+                      offsetof(MoveSpec, v_entry2) == offsetof(MoveSpec, dv2) + 8 &&
+                      offsetof(PlanBlock, feed) == offsetof(PlanBlock, dv2) + 4 &&
+                      offsetof(PlanBlock, v_entry2) == offsetof(PlanBlock, dv2) + 8,
+                  "dv2, feed, v_entry2 in the same order");
+    memcpy(&s.dv2, &b->dv2, 12);
+    s.group = b->group;
+    s.v_nominal2 = speed2_of(s.feed);
+    s.v_exit2 = exit2_of_first();
+    s.curve = b->curve ? &curves_[b->curve - 1] : nullptr;
     s.accel = 0;
-    s.dv2 = b.dv2; // the profile from the planner's own 2 a L
-    s.curve = b.curve ? &curves_[b.curve - 1] : nullptr;
-    if (b.dv2 == 0xFFFFFFFFul) {
+    if (s.dv2 == 0xFFFFFFFFul) {
         // dv2 saturated: the acceleration from the limits again.
         s.dv2 = 0;
         if (s.curve) {
-            uint8_t ax[3];
-            plane_axes(s.curve->plane, ax);
-            s.accel = curve_accel(*m_, s.curve->plane, s.delta[ax[2]] != 0);
+            const uint8_t plane = s.curve->plane;
+            s.accel = curve_accel(*m_, plane, s.delta[2 - plane] != 0);
         } else {
             MoveLimits lim;
-            move_limits(*m_, s.delta, b.group, lim);
+            move_limits(*m_, s.delta, s.group, lim);
             s.accel = lim.accel;
         }
     }
-    s.feed = b.feed;
-    s.v_entry2 = b.v_entry2;
-    s.v_nominal2 = nominal2(b);
-    s.v_exit2 = exit2_of_first();
-    s.group = b.group;
     return s;
 }
 
 uint32_t Planner::exit2_of_first() const {
-    return count_ > 1 ? ring_[index(1)].v_entry2 : 0;
+    return count_ > 1 ? const_cast<Planner*>(this)->at(1)->v_entry2 : 0;
 }
 
 void Planner::discard_first() {
     if (!count_) return;
     const PlanBlock& b = ring_[head_];
-    if (b.curve) curve_used_ = static_cast<uint8_t>(curve_used_ & ~(1u << (b.curve - 1)));
+    // Slot s is bit s + 1 of curve_used_ with two slots, i.e. the block's curve field.
+    curve_used_ = static_cast<uint8_t>(curve_used_ & ~b.curve);
     head_ = index(1);
     --count_;
     first_begun_ = 0;
@@ -392,9 +415,9 @@ void Planner::discard_first() {
 
 void Planner::restart_first(uint32_t remaining, uint32_t total) {
     if (!count_) return;
-    PlanBlock& b = ring_[head_];
-    if (total != 0) b.dv2 = Num(remaining).div(total).of(b.dv2);
-    b.v_entry2 = 0;
+    PlanBlock* const b = ring_ + head_;
+    if (total != 0) b->dv2 = Num(remaining).div(total).of(b->dv2);
+    b->v_entry2 = 0;
     first_begun_ = 1;
     recalculate(true);
 }

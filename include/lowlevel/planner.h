@@ -3,9 +3,10 @@
 // from, recomputed as moves arrive (backward then forward pass). Speeds are squared, in
 // (units/min)^2 of each move's regulated path (seed §3.1); integer only.
 //
-// A queued move costs 33 bytes of RAM: deltas are kept on 24 bits; the length is kept (the step
-// generator needs it when the move starts, and recomputing it took a square root per move) and
-// the acceleration is derived from dv2 and the length instead of being stored.
+// A queued move costs 33 bytes of RAM (4 axes): deltas are kept on 24 bits, the group and the
+// curve slot share a byte; the length is kept (the step generator needs it when the move starts,
+// and recomputing it took a square root per move) and the acceleration is derived from dv2 and
+// the length instead of being stored.
 #pragma once
 
 #include "lowlevel/machine.h"
@@ -15,16 +16,18 @@ namespace ll {
 
 /// Curves queued at once (each keeps its geometry in a slot: RAM is the limit).
 constexpr uint8_t kCurveSlots = 2;
+static_assert(kAxes <= 6 && kCurveSlots <= 3, "a block's group and curve share one byte");
 
 struct PlanBlock {
     uint8_t delta[kAxes][3]; ///< steps per machine axis, signed 24-bit little-endian
-    uint8_t group;           ///< regulated axes (seed §3.1)
-    uint8_t curve;           ///< 0: a straight move; else 1 + the slot of its curve
-    uint32_t feed;           ///< nominal speed, units/min x1000
+    uint8_t group : 6;       ///< regulated axes (seed §3.1)
+    uint8_t curve : 2;       ///< 0: a straight move; else 1 + the slot of its curve
     uint32_t len_q8;         ///< length of the regulated path, µm x 256 (for the step generator)
-    uint32_t dv2;            ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
-    uint32_t v_entry2;       ///< planned entry speed squared
-    uint32_t v_max_entry2;   ///< junction and nominal limit on the entry speed squared
+    // dv2, feed, v_entry2: in MoveSpec's order (spec_of_first() copies them at once).
+    uint32_t dv2;          ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
+    uint32_t feed;         ///< nominal speed, units/min x1000
+    uint32_t v_entry2;     ///< planned entry speed squared
+    uint32_t v_max_entry2; ///< junction and nominal limit on the entry speed squared
 };
 
 /// Length, acceleration and speed limit of a move along its regulated path (every axis, in
@@ -85,28 +88,44 @@ class Planner {
 
     /// Nominal speed squared of a move, (units/min)^2.
     static uint32_t nominal2(const PlanBlock& b);
-    static int32_t delta(const PlanBlock& b, uint8_t axis);
+    /// Steps of a move along an axis (its 24-bit delta, sign-extended).
+    static int32_t delta(const PlanBlock& b, uint8_t axis) {
+        const uint8_t* d = b.delta[axis];
+        uint32_t v = d[0] | static_cast<uint32_t>(d[1]) << 8 | static_cast<uint32_t>(d[2]) << 16;
+        if (v & 0x800000ul) v |= 0xFF000000ul; // sign extension
+        return static_cast<int32_t>(v);
+    }
 
   private:
     uint8_t index(uint8_t i) const { return static_cast<uint8_t>((head_ + i) % kPlannerSize); }
+    /// The i-th queued move (0 = oldest; count_ for the one being queued).
+    PlanBlock* at(uint8_t i);
     /// The look-ahead passes; `all`: do not stop where nothing changes (after a restart).
     void recalculate(bool all = false);
     /// Junction speed squared with the previous move, or any value >= `limit` when it is at
     /// least that (the caller takes the minimum).
     uint32_t junction2(const int32_t unit[kAxes], uint32_t limit) const;
 
-    void finish_block(PlanBlock& b, const int32_t unit_in[kAxes], const int32_t unit_out[kAxes]);
+    /// Writes the move from the last target to `target` (steps) into `b` and `d`; `target`
+    /// becomes the last target. Returns false when no axis moves.
+    bool open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]);
+    /// Completes the block being queued (its deltas, curve and dv2 written): feed (at least 1),
+    /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes. The
+    /// caller then sets prev_unit_ to the direction it ends along.
+    void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed, uint32_t len_q8,
+                      const int32_t unit_in[kAxes]);
 
+    // The small fields first: within 64 bytes of `this`, the ATmega328P reaches them with one
+    // displacement instruction instead of an address computation.
     const Machine* m_;
-    uint8_t curve_used_; ///< bit i: curves_[i] belongs to a queued move
-    CurveParams curves_[kCurveSlots];
     uint8_t head_;
     uint8_t count_;
     uint8_t first_begun_; ///< the oldest move is in the step generator: its entry is fixed
-    uint8_t prev_group_;  ///< 0: no previous move (start from rest)
+    uint8_t curve_used_;  ///< bit i: curves_[i] belongs to a queued move
     int32_t last_[kAxes];
     int32_t last_um_[kAxes];
     int32_t prev_unit_[kAxes]; ///< unit vector of the last move, Q29
+    CurveParams curves_[kCurveSlots];
     PlanBlock ring_[kPlannerSize];
 };
 
