@@ -11,14 +11,16 @@ namespace ll {
 namespace motion {
 namespace {
 
+// No default member initialisers: a zero-filled static object needs no constructor (init()
+// sets every field).
 struct Motion {
+    State state;
+    bool begun;          ///< the planner's first move is in the step generator
+    bool enabled;        ///< stepper drivers enabled
+    uint32_t idle_since; ///< hal::millis() when motion last stopped
     Machine machine;
     Planner planner;
     StepGen gen;
-    State state = State::Idle;
-    bool begun = false;      ///< the planner's first move is in the step generator
-    bool enabled = false;    ///< stepper drivers enabled
-    uint32_t idle_since = 0; ///< hal::millis() when motion last stopped
 };
 
 Motion g_motion;
@@ -76,27 +78,36 @@ void reset_planner(Motion& m, const int32_t here[kAxes]) {
     m.planner.reset(here, um);
 }
 
-void enable(Motion& m, bool on) {
+__attribute__((noinline)) void enable(Motion& m, bool on) {
     if (m.enabled == on) return;
     m.enabled = on;
     hal::stepper_enable(on);
 }
 
-} // namespace
+__attribute__((noinline)) void go_idle(Motion& m) {
+    m.state = State::Idle;
+    m.idle_since = hal::millis();
+}
 
-void init() {
-    Motion& m = mo();
+// Stops the step timer, forgets every queued run and move; the machine is at `here`, steps.
+void restart(Motion& m, const int32_t here[kAxes]) {
     hal::stepper_stop();
     g_runs.clear();
     m.gen.clear_queue_time();
     g_exec.starved = 0;
-    int32_t zero[kAxes] = {};
     m.gen.abort();
-    m.gen.set_position(zero);
-    m.planner.reset(zero, zero);
+    m.gen.set_position(here);
+    reset_planner(m, here);
     m.begun = false;
-    m.enabled = false;
-    m.state = State::Idle;
+    go_idle(m);
+}
+
+} // namespace
+
+void init() {
+    int32_t zero[kAxes] = {};
+    restart(mo(), zero);
+    mo().enabled = false;
     g_starvations = 0;
 }
 
@@ -137,8 +148,9 @@ void poll() {
         return;
     }
     produce(m);
+    bool pending = m.begun || !m.planner.empty(); // a move is left to produce
     if (!g_exec.running) {
-        if (g_exec.starved && (m.begun || !m.planner.empty()) && !m.gen.stopped()) {
+        if (g_exec.starved && pending && !m.gen.stopped()) {
             g_starvations = static_cast<uint16_t>(g_starvations + 1); // dry mid-move
         }
         g_exec.starved = 0;
@@ -147,14 +159,11 @@ void poll() {
             hal::stepper_start();
         }
     }
-    bool drained = g_runs.empty() && !g_exec.running;
+    if (!g_runs.empty() || g_exec.running) return; // not drained
     if (m.state == State::Holding) {
-        if (drained && (m.gen.stopped() || (!m.begun && m.planner.empty()))) m.state = State::Held;
-    } else if (m.state == State::Cycle) {
-        if (drained && !m.begun && m.planner.empty()) {
-            m.state = State::Idle;
-            m.idle_since = hal::millis();
-        }
+        if (m.gen.stopped() || !pending) m.state = State::Held;
+    } else if (m.state == State::Cycle && !pending) {
+        go_idle(m);
     }
 }
 
@@ -187,26 +196,19 @@ void cycle_start() {
     } else {
         m.gen.resume(0);
     }
-    m.state = (m.begun || !m.planner.empty()) ? State::Cycle : State::Idle;
-    if (m.state == State::Idle) m.idle_since = hal::millis();
+    if (m.begun || !m.planner.empty()) {
+        m.state = State::Cycle;
+    } else {
+        go_idle(m);
+    }
     poll();
 }
 
 bool abort() {
-    Motion& m = mo();
     bool moving = g_exec.running != 0;
     int32_t here[kAxes];
     position(here);
-    hal::stepper_stop();
-    g_runs.clear();
-    m.gen.clear_queue_time();
-    g_exec.starved = 0;
-    m.gen.abort();
-    m.gen.set_position(here);
-    reset_planner(m, here);
-    m.begun = false;
-    m.state = State::Idle;
-    m.idle_since = hal::millis();
+    restart(mo(), here);
     return moving;
 }
 
