@@ -342,9 +342,11 @@ uint32_t shl_sat(uint32_t x, uint8_t k) {
 
 namespace {
 
-// atan(2^-i) in radians x 2^29 for i < 10; beyond, atan(2^-i) = 2^-i to the last bit.
-const uint32_t kAtanQ29[10] LL_PROGMEM = {421657428, 248918915, 131521918, 66762579, 33510843,
-                                          16771758,  8387925,   4194219,   2097141,  1048575};
+// atan(2^-i) in radians x 2^29 for i <= 10; beyond, atan(2^-i) = 2^-i to the last bit (and
+// 2^-10 already is: the last entry is 2^19, halved from there on).
+const uint32_t kAtanQ29[11] LL_PROGMEM = {421657428, 248918915, 131521918, 66762579,
+                                          33510843,  16771758,  8387925,   4194219,
+                                          2097141,   1048575,   524288};
 
 // (a * b) >> 30 for Q30 operands (the arithmetic shift of the exact 64-bit product). From the
 // unsigned product: a negative operand subtracts the other one times 2^32.
@@ -392,18 +394,18 @@ int32_t atan2_q29(int32_t y, int32_t x) {
         y *= 2;
         big <<= 1;
     }
+    uint32_t a = 0;
     for (uint8_t i = 0; i < 30; ++i) {
-        int32_t a = i < 10 ? static_cast<int32_t>(flash_read_u32(&kAtanQ29[i]))
-                           : static_cast<int32_t>(1l << (29 - i));
+        a = i <= 10 ? flash_read_u32(&kAtanQ29[i]) : a >> 1;
         int32_t xs = x >> i, ys = y >> i;
         if (y > 0) {
             x += ys;
             y -= xs;
-            z += a;
+            z += static_cast<int32_t>(a);
         } else {
             x -= ys;
             y += xs;
-            z -= a;
+            z -= static_cast<int32_t>(a);
         }
     }
     return z;
