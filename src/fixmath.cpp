@@ -156,15 +156,16 @@ inline uint32_t shr_sat(uint32_t hi, uint32_t lo, uint8_t shift) {
 }
 #endif
 
-// floor(sqrt(v)), and v - floor(sqrt(v))^2 in rem.
-uint16_t isqrt_rem(uint32_t v, uint32_t& rem) {
+} // namespace
+
+uint16_t isqrt32(uint32_t v) {
 #if defined(__AVR__)
     // Bit by bit from the top, with hardware squares: the high byte against the top 16 bits of
     // v (one 8x8 product per bit), then the low byte against all of v (two products per bit,
     // the high byte's square computed once).
     uint8_t sh, sl, t, bit, zero;
     uint16_t hh;
-    uint32_t sq, acc;
+    uint32_t sq;
     asm("clr  %[z]\n\t"
         "clr  %[sh]\n\t"
         "ldi  %[bit], 0x80\n"
@@ -181,9 +182,6 @@ uint16_t isqrt_rem(uint32_t v, uint32_t& rem) {
         "brne 1b\n\t"
         "mul  %[sh], %[sh]\n\t"
         "movw %A[hh], r0\n\t"
-        "clr  %A[acc]\n\t" // accepted square: sh^2 * 2^16
-        "clr  %B[acc]\n\t"
-        "movw %C[acc], %A[hh]\n\t"
         "clr  %[sl]\n\t"
         "ldi  %[bit], 0x80\n"
         "3:\n\t"
@@ -204,20 +202,14 @@ uint16_t isqrt_rem(uint32_t v, uint32_t& rem) {
         "cpc  %C[v], %C[sq]\n\t"
         "cpc  %D[v], %D[sq]\n\t"
         "brcs 4f\n\t"
-        "mov  %[sl], %[t]\n\t"
-        "movw %A[acc], %A[sq]\n\t"
-        "movw %C[acc], %C[sq]\n"
+        "mov  %[sl], %[t]\n"
         "4:\n\t"
         "lsr  %[bit]\n\t"
         "brne 3b\n\t"
-        "clr  __zero_reg__\n\t"
-        "sub  %A[v], %A[acc]\n\t"
-        "sbc  %B[v], %B[acc]\n\t"
-        "sbc  %C[v], %C[acc]\n\t"
-        "sbc  %D[v], %D[acc]"
-        : [v] "+r"(v), [sh] "=&r"(sh), [sl] "=&r"(sl), [t] "=&r"(t), [bit] "=&d"(bit),
-          [z] "=&r"(zero), [hh] "=&r"(hh), [sq] "=&r"(sq), [acc] "=&r"(acc));
-    rem = v;
+        "clr  __zero_reg__"
+        : [sh] "=&r"(sh), [sl] "=&r"(sl), [t] "=&r"(t), [bit] "=&d"(bit), [z] "=&r"(zero),
+          [hh] "=&r"(hh), [sq] "=&r"(sq)
+        : [v] "r"(v));
     return static_cast<uint16_t>(sh << 8 | sl);
 #else
     uint32_t res = 0;
@@ -232,30 +224,43 @@ uint16_t isqrt_rem(uint32_t v, uint32_t& rem) {
         }
         one >>= 2;
     }
-    rem = v;
     return static_cast<uint16_t>(res);
 #endif
 }
+
+namespace {
 
 // floor(rem * 2^15 / s) for 2^15 <= s < 2^16 and rem <= 2 s: the Newton correction of a
 // square root (a quotient below 2^17).
 uint32_t sqrt_step(uint32_t rem, uint16_t s) {
     // rem = q0 s + r with q0 <= 2, then 15 quotient bits of r * 2^15 / s.
-    uint8_t q0 = 0;
-    while (rem >= s) {
-        rem -= s;
-        ++q0;
-    }
-    uint16_t r = static_cast<uint16_t>(rem);
 #if defined(__AVR__)
-    uint16_t q;
+    // One block: q0 counted into the quotient's low byte, which the 15 turns then shift up to
+    // bits 15..16 (a 3-byte quotient; its top byte stays zero).
+    uint32_t q;
     uint8_t n;
     asm("clr  %A[q]\n\t"
         "clr  %B[q]\n\t"
+        "clr  %C[q]\n\t"
+        "clr  %D[q]\n"
+        "0:\n\t"
+        "cp   %A[r], %A[s]\n\t"
+        "cpc  %B[r], %B[s]\n\t"
+        "cpc  %C[r], __zero_reg__\n\t"
+        "cpc  %D[r], __zero_reg__\n\t"
+        "brcs 4f\n\t"
+        "sub  %A[r], %A[s]\n\t"
+        "sbc  %B[r], %B[s]\n\t"
+        "sbc  %C[r], __zero_reg__\n\t"
+        "sbc  %D[r], __zero_reg__\n\t"
+        "inc  %A[q]\n\t"
+        "rjmp 0b\n"
+        "4:\n\t"
         "ldi  %[n], 15\n"
         "1:\n\t"
         "lsl  %A[q]\n\t"
         "rol  %B[q]\n\t"
+        "rol  %C[q]\n\t"
         "lsl  %A[r]\n\t"
         "rol  %B[r]\n\t"
         "brcs 2f\n\t"
@@ -269,9 +274,16 @@ uint32_t sqrt_step(uint32_t rem, uint16_t s) {
         "3:\n\t"
         "dec  %[n]\n\t"
         "brne 1b"
-        : [q] "=&r"(q), [r] "+r"(r), [n] "=&d"(n)
+        : [q] "=&r"(q), [r] "+r"(rem), [n] "=&d"(n)
         : [s] "r"(s));
+    return q;
 #else
+    uint8_t q0 = 0;
+    while (rem >= s) {
+        rem -= s;
+        ++q0;
+    }
+    uint16_t r = static_cast<uint16_t>(rem);
     uint16_t q = 0;
     for (uint8_t i = 0; i < 15; ++i) {
         bool carry = (r & 0x8000u) != 0;
@@ -282,18 +294,11 @@ uint32_t sqrt_step(uint32_t rem, uint16_t s) {
             q = static_cast<uint16_t>(q | 1);
         }
     }
+    return static_cast<uint32_t>(q0) << 15 | q;
 #endif
-    uint32_t out = q;
-    if (q0) out += q0 == 1 ? 0x8000ul : 0x10000ul; // q0 << 15 without a 15-turn shift loop
-    return out;
 }
 
 } // namespace
-
-uint16_t isqrt32(uint32_t v) {
-    uint32_t rem;
-    return isqrt_rem(v, rem);
-}
 
 uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits) {
     uint32_t q = num < den ? 0 : num / den; // short lines: num < den, no library division
@@ -577,8 +582,8 @@ Num& Num::sqrt() {
     // sqrt(v * 2^ex) = sqrt(v) * 2^(ex/2). s = floor(sqrt(v)) to 16 bits, then one Newton step
     // from r = s * 2^16: r' = (r + v * 2^32 / r) / 2 = s * 2^16 + (v - s^2) * 2^15 / s, within
     // one unit of sqrt(v) * 2^16 (2^-31 relative). It reaches 2^32 just below v = 2^32.
-    uint32_t rem;
-    uint16_t s = isqrt_rem(v, rem);
+    uint16_t s = isqrt32(v);
+    uint32_t rem = v - static_cast<uint32_t>(s) * s;
     uint32_t top = static_cast<uint32_t>(s) << 16; // >= 2^31: the result is normalised
     uint32_t next = top + sqrt_step(rem, s);
     ex = static_cast<int8_t>((ex >> 1) - 16); // ex is even
