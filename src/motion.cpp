@@ -214,27 +214,27 @@ bool abort() {
 
 void position(int32_t steps[kAxes]) {
     Motion& m = mo();
-    uint8_t head, remaining, cur_steps, cur_dirs;
+    uint8_t i, n, s, d;
     {
         hal::Critical cs;
-        head = g_runs.head;
-        remaining = g_exec.remaining;
-        cur_steps = g_exec.steps;
-        cur_dirs = g_exec.dirs;
+        i = g_runs.head;
+        n = g_exec.remaining;
+        s = g_exec.steps;
+        d = g_exec.dirs;
     }
     m.gen.pushed_position(steps);
     // Undo what is queued but not executed: the rest of the current run, then every run
     // between the consumer and the producer.
-    auto undo = [&](uint8_t s, uint8_t d, uint8_t n) {
+    for (;;) {
         for (uint8_t a = 0; a < kAxes; ++a, s >>= 1, d >>= 1) {
-            if (s & 1) steps[a] += (d & 1) ? n : -static_cast<int32_t>(n);
+            if (s & 1) steps[a] += (d & 1) ? n : -static_cast<int16_t>(n);
         }
-    };
-    undo(cur_steps, cur_dirs, remaining);
-    for (uint8_t i = head; i != g_runs.tail;
-         i = static_cast<uint8_t>((i + 1) & (kRunQueueSize - 1))) {
+        if (i == g_runs.tail) return;
         const Run& r = g_runs.buf[i];
-        undo(r.steps, r.dirs, r.count);
+        s = r.steps;
+        d = r.dirs;
+        n = r.count;
+        i = static_cast<uint8_t>((i + 1) & (kRunQueueSize - 1));
     }
 }
 
