@@ -388,7 +388,8 @@ int32_t atan2_q29(int32_t y, int32_t x) {
             z = -kPiQ29 / 2;
         }
     }
-    uint32_t big = abs32(x) > abs32(y) ? abs32(x) : abs32(y);
+    // max(|x|, |y|) matters only through its top bit, which |x| | |y| has too.
+    uint32_t big = abs32(x) | abs32(y);
     while (big >= (1ul << 29)) {
         x >>= 1;
         y >>= 1;
