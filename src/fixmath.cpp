@@ -301,8 +301,11 @@ uint32_t sqrt_step(uint32_t rem, uint16_t s) {
 } // namespace
 
 uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits) {
-    uint32_t q = num < den ? 0 : num / den; // short lines: num < den, no library division
-    uint32_t rem = num - q * den;
+    uint32_t q = 0, rem = num;
+    if (num >= den) { // short lines: num < den, no library division
+        q = num / den;
+        rem = num % den; // the same library call
+    }
     for (uint8_t i = 0; i < bits; ++i) {
         rem <<= 1;
         q <<= 1;
