@@ -56,7 +56,9 @@ bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) {
         // Positions stay within +-2^30 steps (the G-code layer's range check), so the
         // difference cannot overflow.
-        if (abs32(to[a] - from[a]) > kMaxLineTicks) return true;
+        // |d| > kMaxLineTicks as one unsigned comparison: d + max wraps above 2 max.
+        uint32_t d = static_cast<uint32_t>(to[a] - from[a]) + kMaxLineTicks;
+        if (d > 2u * kMaxLineTicks) return true;
     }
     return false;
 }
