@@ -15,10 +15,11 @@ const uint32_t kPow10[10] LL_PROGMEM = {1u,      10u,      100u,      1000u,    
 // Digits of m, with at least `decimals + 1` of them and a point before the last `decimals`.
 void digits(uint32_t m, uint8_t decimals) {
     bool started = false;
+    const uint32_t* pow10 = kPow10 + 10;
     uint8_t p = 10;
     do {
         --p;
-        uint32_t pw = flash_read_u32(&kPow10[p]);
+        uint32_t pw = flash_read_u32(--pow10);
         char d = '0';
         while (m >= pw) {
             m -= pw;
@@ -26,14 +27,14 @@ void digits(uint32_t m, uint8_t decimals) {
         }
         if (d != '0' || p <= decimals) started = true;
         if (!started) continue;
-        if (p + 1 == decimals) ch('.');
+        if (static_cast<uint8_t>(p + 1) == decimals) ch('.');
         ch(d);
     } while (p != 0);
 }
 
 // value x mul / div, rounded half away from zero, printed with `decimals` decimals.
 void scaled(int32_t v, uint8_t mul, uint16_t div, uint8_t decimals) {
-    if (div != 1) num::mul_div_round(v, mul, div, v);
+    num::mul_div_round(v, mul, div, v); // div > 1 at every call
     fixed(v, decimals);
 }
 } // namespace
@@ -94,9 +95,13 @@ void coord(int32_t um) {
 }
 
 void coords(const int32_t* um) {
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        if (a != 0) ch(',');
-        coord(um != nullptr ? um[a] : 0);
+    uint8_t a = 0;
+    for (;;) {
+        int32_t v = 0;
+        if (um != nullptr) v = um[a];
+        coord(v);
+        if (++a == kAxes) return;
+        ch(',');
     }
 }
 
