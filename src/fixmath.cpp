@@ -608,12 +608,14 @@ Num& Num::mul(const Num& o) {
 }
 #endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::mulc(uint32_t mant, int8_t exp) {
     Num c;
     c.m = mant;
     c.e = exp;
     return mul(c);
 }
+#endif
 
 #if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::mul(uint32_t v) {

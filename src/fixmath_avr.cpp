@@ -86,9 +86,20 @@ asm(".section .text._ZN2ll3Num3setEma,\"ax\",@progbits\n"
 // Num& Num::mul(const Num& o): &o in r22:r23. The 64-bit product of the mantissas by
 // __ll_mul32 (fixmath.cpp), its top 33 bits normalised; truncated.
 asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n"
+    // Num& Num::mulc(uint32_t mant, int8_t exp): mant (normalised) in r20..r23, exp in r18;
+    // mul(uint32_t) without its normalisation (T clear).
+    ".global _ZN2ll3Num4mulcEma\n"
+    ".type _ZN2ll3Num4mulcEma, @function\n"
+    "_ZN2ll3Num4mulcEma:\n"
+    "mov  r26, r18\n"
+    "clt\n"
+    "rjmp 1f\n"
+    ".size _ZN2ll3Num4mulcEma, .-_ZN2ll3Num4mulcEma\n"
     ".global _ZN2ll3Num3mulEm\n" // Num& Num::mul(uint32_t v): v in r20..r23, normalised here
     ".type _ZN2ll3Num3mulEm, @function\n"
     "_ZN2ll3Num3mulEm:\n"
+    "set\n"
+    "1:\n"
     "push r12\n"
     "push r13\n"
     "push r14\n"
@@ -100,7 +111,9 @@ asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n"
     "movw r28, r24\n"
     "movw r18, r20\n"
     "movw r20, r22\n"
+    "brtc 2f\n"
     "call __ll_norm\n" // zero stays zero: .Lmul_loaded tests the top byte
+    "2:\n"
     "mov  r12, r26\n"
     "ld   r22, Y\n"
     "ldd  r23, Y+1\n"
