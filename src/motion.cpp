@@ -29,21 +29,19 @@ inline Motion& mo() {
     return g_motion;
 }
 
-void begin_next(Motion& m) {
-    while (!m.begun && !m.planner.empty()) {
-        if (m.gen.begin(m.planner.spec_of_first())) {
-            m.planner.begin_first();
-            m.begun = true;
-        } else {
-            m.planner.discard_first();
-        }
-    }
-}
-
+// Hands the planner's moves to the step generator and lets it fill the run queue, until the
+// queue is full, a hold stops it or nothing is left.
 void produce(Motion& m) {
     for (;;) {
-        begin_next(m);
-        if (!m.begun) return;
+        if (!m.begun) {
+            if (m.planner.empty()) return;
+            if (!m.gen.begin(m.planner.spec_of_first())) { // no step: drop it
+                m.planner.discard_first();
+                continue;
+            }
+            m.planner.begin_first();
+            m.begun = true;
+        }
         m.gen.set_exit(m.planner.exit2_of_first());
         m.gen.fill(g_runs);
         if (m.gen.active() || m.gen.stopped()) return; // queue full, or held
