@@ -686,14 +686,17 @@ Num& Num::sqrt() {
     // one unit of sqrt(v) * 2^16 (2^-31 relative). It reaches 2^32 just below v = 2^32.
     uint16_t s = isqrt32(v);
     uint32_t rem = v - static_cast<uint32_t>(s) * s;
-    uint32_t top = static_cast<uint32_t>(s) << 16; // >= 2^31: the result is normalised
-    uint32_t next = top + sqrt_step(rem, s);
-    ex = static_cast<int8_t>((ex >> 1) - 16); // ex is even
-    if (next < top) {                         // 2^32
-        next = 0x80000000ul;
-        ++ex;
+    // s * 2^16 + q, q < 2^17: the top half s + (q >> 16) (s >= 2^15: normalised), which
+    // wraps to 0 only when the sum is 2^32.
+    uint32_t q = sqrt_step(rem, s);
+    uint16_t hi = static_cast<uint16_t>(s + static_cast<uint16_t>(q >> 16));
+    ex = static_cast<int8_t>(ex / 2 - 16); // ex is even
+    if (hi < s) {                          // 2^32
+        m = 0x80000000ul;
+        e = static_cast<int8_t>(ex + 1);
+        return *this;
     }
-    m = next;
+    m = static_cast<uint32_t>(hi) << 16 | static_cast<uint16_t>(q);
     e = ex;
     return *this;
 }
