@@ -65,14 +65,12 @@ bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
 // the machine is between targets; the next move's direction is taken from here).
 void position_um(Motion& m, const int32_t steps[kAxes], int32_t um[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) {
-        int32_t s = steps[a];
-        uint32_t mag = s < 0 ? static_cast<uint32_t>(-(s + 1)) + 1u : static_cast<uint32_t>(s);
-        int32_t v = static_cast<int32_t>(m.machine.um_q8_per_step[a].of(mag) >> 8);
-        um[a] = s < 0 ? -v : v;
+        uint32_t v = m.machine.um_q8_per_step[a].of(abs32(steps[a])) >> 8;
+        um[a] = static_cast<int32_t>(steps[a] < 0 ? 0u - v : v);
     }
 }
 
-void reset_planner(Motion& m, const int32_t here[kAxes]) {
+__attribute__((noinline)) void reset_planner(Motion& m, const int32_t here[kAxes]) {
     int32_t um[kAxes];
     position_um(m, here, um);
     m.planner.reset(here, um);
