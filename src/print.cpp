@@ -15,11 +15,10 @@ const uint32_t kPow10[10] LL_PROGMEM = {1u,      10u,      100u,      1000u,    
 // Digits of m, with at least `decimals + 1` of them and a point before the last `decimals`.
 void digits(uint32_t m, uint8_t decimals) {
     bool started = false;
-    const uint32_t* pow10 = kPow10 + 10;
     uint8_t p = 10;
     do {
         --p;
-        uint32_t pw = flash_read_u32(--pow10);
+        uint32_t pw = flash_read_u32(&kPow10[p]);
         char d = '0';
         while (m >= pw) {
             m -= pw;
@@ -95,12 +94,11 @@ void coord(int32_t um) {
 }
 
 void coords(const int32_t* um) {
-    uint8_t a = 0;
-    for (;;) {
+    for (uint8_t a = kAxes;;) {
         int32_t v = 0;
-        if (um != nullptr) v = um[a];
+        if (um != nullptr) v = *um++;
         coord(v);
-        if (++a == kAxes) return;
+        if (--a == 0) return;
         ch(',');
     }
 }
