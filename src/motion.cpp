@@ -171,16 +171,16 @@ State state() {
 
 void feed_hold() {
     Motion& m = mo();
-    if (m.state == State::Idle) {
-        // GRBL 1.1: a hold while idle is a complete hold. Moves sent meanwhile are planned
-        // (full look-ahead) but none starts until cycle start: the generator, holding at zero
-        // speed, stops at the first segment of any move it is given.
-        m.gen.hold();
+    State s = m.state;
+    if (s != State::Idle && s != State::Cycle) return;
+    // GRBL 1.1: a hold while idle is a complete hold. Moves sent meanwhile are planned (full
+    // look-ahead) but none starts until cycle start: the generator, holding at zero speed, stops
+    // at the first segment of any move it is given.
+    m.gen.hold();
+    if (s == State::Idle) {
         m.state = State::Held;
         return;
     }
-    if (m.state != State::Cycle) return;
-    m.gen.hold();
     m.state = State::Holding;
     poll();
 }
