@@ -17,7 +17,7 @@ struct Motion {
     State state;
     bool begun;          ///< the planner's first move is in the step generator
     bool enabled;        ///< stepper drivers enabled
-    uint32_t idle_since; ///< hal::millis() when motion last stopped
+    uint16_t idle_since; ///< hal::millis() when motion last stopped, low 16 bits ($1 <= 254 ms)
     Machine machine;
     Planner planner;
     StepGen gen;
@@ -84,7 +84,7 @@ __attribute__((noinline)) void enable(Motion& m, bool on) {
 
 __attribute__((noinline)) void go_idle(Motion& m) {
     m.state = State::Idle;
-    m.idle_since = hal::millis();
+    m.idle_since = static_cast<uint16_t>(hal::millis());
 }
 
 // Stops the step timer, forgets every queued run and move; the machine is at `here`, steps.
@@ -140,7 +140,7 @@ void poll() {
     Motion& m = mo();
     if (m.state == State::Idle && m.planner.empty() && g_runs.empty() && !g_exec.running) {
         if (m.enabled && g_settings.idle_delay_ms != 255 &&
-            hal::millis() - m.idle_since >= g_settings.idle_delay_ms) {
+            static_cast<uint16_t>(hal::millis() - m.idle_since) >= g_settings.idle_delay_ms) {
             enable(m, false);
         }
         return;
