@@ -341,11 +341,40 @@ uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift) {
 uint32_t shl_sat(uint32_t x, uint8_t k) {
     // A bit at a time: the shifts are small where it matters (the speed profile, k < 9), and a
     // test against 2^32 >> k would be a second variable shift (a loop on the ATmega328P).
-    for (; k != 0 && x != 0; --k) {
+    // Zero stays zero; anything else saturates within 32 turns.
+#if defined(__AVR__)
+    asm("tst  %[k]\n\t"
+        "breq 3f\n\t"
+        "mov  __tmp_reg__, %A[x]\n\t"
+        "or   __tmp_reg__, %B[x]\n\t"
+        "or   __tmp_reg__, %C[x]\n\t"
+        "or   __tmp_reg__, %D[x]\n\t"
+        "breq 3f\n"
+        "1:\n\t"
+        "sbrc %D[x], 7\n\t"
+        "rjmp 2f\n\t"
+        "lsl  %A[x]\n\t"
+        "rol  %B[x]\n\t"
+        "rol  %C[x]\n\t"
+        "rol  %D[x]\n\t"
+        "dec  %[k]\n\t"
+        "brne 1b\n\t"
+        "rjmp 3f\n"
+        "2:\n\t"
+        "ldi  %A[x], 0xFF\n\t"
+        "ldi  %B[x], 0xFF\n\t"
+        "movw %C[x], %A[x]\n"
+        "3:"
+        : [x] "+d"(x), [k] "+r"(k));
+    return x;
+#else
+    if (x == 0) return 0;
+    for (; k != 0; --k) {
         if (x & 0x80000000ul) return 0xFFFFFFFFul;
         x <<= 1;
     }
     return x;
+#endif
 }
 
 namespace {

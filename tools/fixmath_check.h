@@ -91,6 +91,7 @@ inline uint32_t fixmath_hash(uint16_t rounds) {
         h.add(z.of(b) ^ x.of(0));
         h.add(Num(y).mul(b >> (xorshift(s) & 31)));
         h.add(Num(y).div(a >> (xorshift(s) & 31)));
+        h.add(shl_sat(any(s), static_cast<uint8_t>(xorshift(s) % 40)));
         h.add(Num(x).mulc(a | 0x80000000ul,
                           static_cast<int8_t>(static_cast<int16_t>(xorshift(s) % 100) - 50)));
         // atan2 in every quadrant, on both axes and at every magnitude (|v| < 2^30).
