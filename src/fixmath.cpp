@@ -738,8 +738,8 @@ Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask) {
         if (static_cast<uint8_t>(v[i] >> 24) >= 0x40) drop = 2;
     }
     uint32_t hi = 0, lo = 0;
-    for (uint8_t i = 0; i < n; ++i, mask >>= 1) {
-        uint32_t x = v[i];
+    for (; n != 0; --n, ++v, mask >>= 1) {
+        uint32_t x = *v;
         if (x == 0 || !(mask & 1)) continue;
         if (drop) x >>= 2;
         uint32_t l, h = mul64(x, x, l);
