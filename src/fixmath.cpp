@@ -156,15 +156,16 @@ inline uint32_t shr_sat(uint32_t hi, uint32_t lo, uint8_t shift) {
 }
 #endif
 
-// floor(sqrt(v)), and v - floor(sqrt(v))^2 in rem.
-uint16_t isqrt_rem(uint32_t v, uint32_t& rem) {
+} // namespace
+
+uint16_t isqrt32(uint32_t v) {
 #if defined(__AVR__)
     // Bit by bit from the top, with hardware squares: the high byte against the top 16 bits of
     // v (one 8x8 product per bit), then the low byte against all of v (two products per bit,
     // the high byte's square computed once).
     uint8_t sh, sl, t, bit, zero;
     uint16_t hh;
-    uint32_t sq, acc;
+    uint32_t sq;
     asm("clr  %[z]\n\t"
         "clr  %[sh]\n\t"
         "ldi  %[bit], 0x80\n"
@@ -181,9 +182,6 @@ uint16_t isqrt_rem(uint32_t v, uint32_t& rem) {
         "brne 1b\n\t"
         "mul  %[sh], %[sh]\n\t"
         "movw %A[hh], r0\n\t"
-        "clr  %A[acc]\n\t" // accepted square: sh^2 * 2^16
-        "clr  %B[acc]\n\t"
-        "movw %C[acc], %A[hh]\n\t"
         "clr  %[sl]\n\t"
         "ldi  %[bit], 0x80\n"
         "3:\n\t"
@@ -204,20 +202,14 @@ uint16_t isqrt_rem(uint32_t v, uint32_t& rem) {
         "cpc  %C[v], %C[sq]\n\t"
         "cpc  %D[v], %D[sq]\n\t"
         "brcs 4f\n\t"
-        "mov  %[sl], %[t]\n\t"
-        "movw %A[acc], %A[sq]\n\t"
-        "movw %C[acc], %C[sq]\n"
+        "mov  %[sl], %[t]\n"
         "4:\n\t"
         "lsr  %[bit]\n\t"
         "brne 3b\n\t"
-        "clr  __zero_reg__\n\t"
-        "sub  %A[v], %A[acc]\n\t"
-        "sbc  %B[v], %B[acc]\n\t"
-        "sbc  %C[v], %C[acc]\n\t"
-        "sbc  %D[v], %D[acc]"
-        : [v] "+r"(v), [sh] "=&r"(sh), [sl] "=&r"(sl), [t] "=&r"(t), [bit] "=&d"(bit),
-          [z] "=&r"(zero), [hh] "=&r"(hh), [sq] "=&r"(sq), [acc] "=&r"(acc));
-    rem = v;
+        "clr  __zero_reg__"
+        : [sh] "=&r"(sh), [sl] "=&r"(sl), [t] "=&r"(t), [bit] "=&d"(bit), [z] "=&r"(zero),
+          [hh] "=&r"(hh), [sq] "=&r"(sq)
+        : [v] "r"(v));
     return static_cast<uint16_t>(sh << 8 | sl);
 #else
     uint32_t res = 0;
@@ -232,30 +224,43 @@ uint16_t isqrt_rem(uint32_t v, uint32_t& rem) {
         }
         one >>= 2;
     }
-    rem = v;
     return static_cast<uint16_t>(res);
 #endif
 }
+
+namespace {
 
 // floor(rem * 2^15 / s) for 2^15 <= s < 2^16 and rem <= 2 s: the Newton correction of a
 // square root (a quotient below 2^17).
 uint32_t sqrt_step(uint32_t rem, uint16_t s) {
     // rem = q0 s + r with q0 <= 2, then 15 quotient bits of r * 2^15 / s.
-    uint8_t q0 = 0;
-    while (rem >= s) {
-        rem -= s;
-        ++q0;
-    }
-    uint16_t r = static_cast<uint16_t>(rem);
 #if defined(__AVR__)
-    uint16_t q;
+    // One block: q0 counted into the quotient's low byte, which the 15 turns then shift up to
+    // bits 15..16 (a 3-byte quotient; its top byte stays zero).
+    uint32_t q;
     uint8_t n;
     asm("clr  %A[q]\n\t"
         "clr  %B[q]\n\t"
+        "clr  %C[q]\n\t"
+        "clr  %D[q]\n"
+        "0:\n\t"
+        "cp   %A[r], %A[s]\n\t"
+        "cpc  %B[r], %B[s]\n\t"
+        "cpc  %C[r], __zero_reg__\n\t"
+        "cpc  %D[r], __zero_reg__\n\t"
+        "brcs 4f\n\t"
+        "sub  %A[r], %A[s]\n\t"
+        "sbc  %B[r], %B[s]\n\t"
+        "sbc  %C[r], __zero_reg__\n\t"
+        "sbc  %D[r], __zero_reg__\n\t"
+        "inc  %A[q]\n\t"
+        "rjmp 0b\n"
+        "4:\n\t"
         "ldi  %[n], 15\n"
         "1:\n\t"
         "lsl  %A[q]\n\t"
         "rol  %B[q]\n\t"
+        "rol  %C[q]\n\t"
         "lsl  %A[r]\n\t"
         "rol  %B[r]\n\t"
         "brcs 2f\n\t"
@@ -269,9 +274,16 @@ uint32_t sqrt_step(uint32_t rem, uint16_t s) {
         "3:\n\t"
         "dec  %[n]\n\t"
         "brne 1b"
-        : [q] "=&r"(q), [r] "+r"(r), [n] "=&d"(n)
+        : [q] "=&r"(q), [r] "+r"(rem), [n] "=&d"(n)
         : [s] "r"(s));
+    return q;
 #else
+    uint8_t q0 = 0;
+    while (rem >= s) {
+        rem -= s;
+        ++q0;
+    }
+    uint16_t r = static_cast<uint16_t>(rem);
     uint16_t q = 0;
     for (uint8_t i = 0; i < 15; ++i) {
         bool carry = (r & 0x8000u) != 0;
@@ -282,22 +294,18 @@ uint32_t sqrt_step(uint32_t rem, uint16_t s) {
             q = static_cast<uint16_t>(q | 1);
         }
     }
+    return static_cast<uint32_t>(q0) << 15 | q;
 #endif
-    uint32_t out = q;
-    if (q0) out += q0 == 1 ? 0x8000ul : 0x10000ul; // q0 << 15 without a 15-turn shift loop
-    return out;
 }
 
 } // namespace
 
-uint16_t isqrt32(uint32_t v) {
-    uint32_t rem;
-    return isqrt_rem(v, rem);
-}
-
 uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits) {
-    uint32_t q = num < den ? 0 : num / den; // short lines: num < den, no library division
-    uint32_t rem = num - q * den;
+    uint32_t q = 0, rem = num;
+    if (num >= den) { // short lines: num < den, no library division
+        q = num / den;
+        rem = num % den; // the same library call
+    }
     for (uint8_t i = 0; i < bits; ++i) {
         rem <<= 1;
         q <<= 1;
@@ -333,18 +341,49 @@ uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift) {
 uint32_t shl_sat(uint32_t x, uint8_t k) {
     // A bit at a time: the shifts are small where it matters (the speed profile, k < 9), and a
     // test against 2^32 >> k would be a second variable shift (a loop on the ATmega328P).
-    for (; k != 0 && x != 0; --k) {
+    // Zero stays zero; anything else saturates within 32 turns.
+#if defined(__AVR__)
+    asm("tst  %[k]\n\t"
+        "breq 3f\n\t"
+        "mov  __tmp_reg__, %A[x]\n\t"
+        "or   __tmp_reg__, %B[x]\n\t"
+        "or   __tmp_reg__, %C[x]\n\t"
+        "or   __tmp_reg__, %D[x]\n\t"
+        "breq 3f\n"
+        "1:\n\t"
+        "sbrc %D[x], 7\n\t"
+        "rjmp 2f\n\t"
+        "lsl  %A[x]\n\t"
+        "rol  %B[x]\n\t"
+        "rol  %C[x]\n\t"
+        "rol  %D[x]\n\t"
+        "dec  %[k]\n\t"
+        "brne 1b\n\t"
+        "rjmp 3f\n"
+        "2:\n\t"
+        "ldi  %A[x], 0xFF\n\t"
+        "ldi  %B[x], 0xFF\n\t"
+        "movw %C[x], %A[x]\n"
+        "3:"
+        : [x] "+d"(x), [k] "+r"(k));
+    return x;
+#else
+    if (x == 0) return 0;
+    for (; k != 0; --k) {
         if (x & 0x80000000ul) return 0xFFFFFFFFul;
         x <<= 1;
     }
     return x;
+#endif
 }
 
 namespace {
 
-// atan(2^-i) in radians x 2^29 for i < 10; beyond, atan(2^-i) = 2^-i to the last bit.
-const uint32_t kAtanQ29[10] LL_PROGMEM = {421657428, 248918915, 131521918, 66762579, 33510843,
-                                          16771758,  8387925,   4194219,   2097141,  1048575};
+// atan(2^-i) in radians x 2^29 for i <= 10; beyond, atan(2^-i) = 2^-i to the last bit (and
+// 2^-10 already is: the last entry is 2^19, halved from there on).
+const uint32_t kAtanQ29[11] LL_PROGMEM = {421657428, 248918915, 131521918, 66762579,
+                                          33510843,  16771758,  8387925,   4194219,
+                                          2097141,   1048575,   524288};
 
 // (a * b) >> 30 for Q30 operands (the arithmetic shift of the exact 64-bit product). From the
 // unsigned product: a negative operand subtracts the other one times 2^32.
@@ -381,7 +420,8 @@ int32_t atan2_q29(int32_t y, int32_t x) {
             z = -kPiQ29 / 2;
         }
     }
-    uint32_t big = abs32(x) > abs32(y) ? abs32(x) : abs32(y);
+    // max(|x|, |y|) matters only through its top bit, which |x| | |y| has too.
+    uint32_t big = abs32(x) | abs32(y);
     while (big >= (1ul << 29)) {
         x >>= 1;
         y >>= 1;
@@ -392,20 +432,116 @@ int32_t atan2_q29(int32_t y, int32_t x) {
         y *= 2;
         big <<= 1;
     }
+#if defined(__AVR__)
+    // The same 30 turns with one 4-byte temporary: x >> i (or y >> i) is applied first, and
+    // the other operand's old value is then recovered from the new one (t + y' = y, t + x' = x)
+    // before its own shift. One shift loop, called twice per turn.
+    uint32_t a, t;
+    uint8_t i, n;
+    const uint32_t* tab = kAtanQ29;
+    asm("clr  %[i]\n"
+        "0:\n\t"
+        "cpi  %[i], 11\n\t"
+        "brsh 1f\n\t"
+        "lpm  %A[a], Z+\n\t"
+        "lpm  %B[a], Z+\n\t"
+        "lpm  %C[a], Z+\n\t"
+        "lpm  %D[a], Z+\n\t"
+        "rjmp 2f\n"
+        "1:\n\t"
+        "lsr  %D[a]\n\t"
+        "ror  %C[a]\n\t"
+        "ror  %B[a]\n\t"
+        "ror  %A[a]\n"
+        "2:\n\t"
+        "sbrc %D[y], 7\n\t"
+        "rjmp 3f\n\t"
+        "cp   %A[y], __zero_reg__\n\t"
+        "cpc  %B[y], __zero_reg__\n\t"
+        "cpc  %C[y], __zero_reg__\n\t"
+        "cpc  %D[y], __zero_reg__\n\t"
+        "breq 3f\n\t"
+        // y > 0: y -= x >> i, x += y >> i (old y), z += a
+        "movw %A[t], %A[x]\n\t"
+        "movw %C[t], %C[x]\n\t"
+        "rcall 5f\n\t"
+        "sub  %A[y], %A[t]\n\t"
+        "sbc  %B[y], %B[t]\n\t"
+        "sbc  %C[y], %C[t]\n\t"
+        "sbc  %D[y], %D[t]\n\t"
+        "add  %A[t], %A[y]\n\t"
+        "adc  %B[t], %B[y]\n\t"
+        "adc  %C[t], %C[y]\n\t"
+        "adc  %D[t], %D[y]\n\t"
+        "rcall 5f\n\t"
+        "add  %A[x], %A[t]\n\t"
+        "adc  %B[x], %B[t]\n\t"
+        "adc  %C[x], %C[t]\n\t"
+        "adc  %D[x], %D[t]\n\t"
+        "add  %A[z], %A[a]\n\t"
+        "adc  %B[z], %B[a]\n\t"
+        "adc  %C[z], %C[a]\n\t"
+        "adc  %D[z], %D[a]\n\t"
+        "rjmp 4f\n"
+        // y <= 0: x -= y >> i, y += x >> i (old x), z -= a
+        "3:\n\t"
+        "movw %A[t], %A[y]\n\t"
+        "movw %C[t], %C[y]\n\t"
+        "rcall 5f\n\t"
+        "sub  %A[x], %A[t]\n\t"
+        "sbc  %B[x], %B[t]\n\t"
+        "sbc  %C[x], %C[t]\n\t"
+        "sbc  %D[x], %D[t]\n\t"
+        "add  %A[t], %A[x]\n\t"
+        "adc  %B[t], %B[x]\n\t"
+        "adc  %C[t], %C[x]\n\t"
+        "adc  %D[t], %D[x]\n\t"
+        "rcall 5f\n\t"
+        "add  %A[y], %A[t]\n\t"
+        "adc  %B[y], %B[t]\n\t"
+        "adc  %C[y], %C[t]\n\t"
+        "adc  %D[y], %D[t]\n\t"
+        "sub  %A[z], %A[a]\n\t"
+        "sbc  %B[z], %B[a]\n\t"
+        "sbc  %C[z], %C[a]\n\t"
+        "sbc  %D[z], %D[a]\n"
+        "4:\n\t"
+        "inc  %[i]\n\t"
+        "cpi  %[i], 30\n\t"
+        "brlo 0b\n\t"
+        "rjmp 7f\n"
+        // t >>= i, arithmetic
+        "5:\n\t"
+        "mov  %[n], %[i]\n\t"
+        "rjmp 6f\n"
+        "8:\n\t"
+        "asr  %D[t]\n\t"
+        "ror  %C[t]\n\t"
+        "ror  %B[t]\n\t"
+        "ror  %A[t]\n"
+        "6:\n\t"
+        "dec  %[n]\n\t"
+        "brpl 8b\n\t"
+        "ret\n"
+        "7:"
+        : [x] "+r"(x), [y] "+r"(y), [z] "+r"(z), [a] "=&r"(a), [t] "=&r"(t), [i] "=&d"(i),
+          [n] "=&r"(n), "+z"(tab));
+#else
+    uint32_t a = 0;
     for (uint8_t i = 0; i < 30; ++i) {
-        int32_t a = i < 10 ? static_cast<int32_t>(flash_read_u32(&kAtanQ29[i]))
-                           : static_cast<int32_t>(1l << (29 - i));
+        a = i <= 10 ? flash_read_u32(&kAtanQ29[i]) : a >> 1;
         int32_t xs = x >> i, ys = y >> i;
         if (y > 0) {
             x += ys;
             y -= xs;
-            z += a;
+            z += static_cast<int32_t>(a);
         } else {
             x -= ys;
             y += xs;
-            z -= a;
+            z -= static_cast<int32_t>(a);
         }
     }
+#endif
     return z;
 }
 
@@ -501,12 +637,14 @@ Num& Num::mul(const Num& o) {
 }
 #endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::mulc(uint32_t mant, int8_t exp) {
     Num c;
     c.m = mant;
     c.e = exp;
     return mul(c);
 }
+#endif
 
 #if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::mul(uint32_t v) {
@@ -575,16 +713,19 @@ Num& Num::sqrt() {
     // sqrt(v * 2^ex) = sqrt(v) * 2^(ex/2). s = floor(sqrt(v)) to 16 bits, then one Newton step
     // from r = s * 2^16: r' = (r + v * 2^32 / r) / 2 = s * 2^16 + (v - s^2) * 2^15 / s, within
     // one unit of sqrt(v) * 2^16 (2^-31 relative). It reaches 2^32 just below v = 2^32.
-    uint32_t rem;
-    uint16_t s = isqrt_rem(v, rem);
-    uint32_t top = static_cast<uint32_t>(s) << 16; // >= 2^31: the result is normalised
-    uint32_t next = top + sqrt_step(rem, s);
-    ex = static_cast<int8_t>((ex >> 1) - 16); // ex is even
-    if (next < top) {                         // 2^32
-        next = 0x80000000ul;
-        ++ex;
+    uint16_t s = isqrt32(v);
+    uint32_t rem = v - static_cast<uint32_t>(s) * s;
+    // s * 2^16 + q, q < 2^17: the top half s + (q >> 16) (s >= 2^15: normalised), which
+    // wraps to 0 only when the sum is 2^32.
+    uint32_t q = sqrt_step(rem, s);
+    uint16_t hi = static_cast<uint16_t>(s + static_cast<uint16_t>(q >> 16));
+    ex = static_cast<int8_t>(ex / 2 - 16); // ex is even
+    if (hi < s) {                          // 2^32
+        m = 0x80000000ul;
+        e = static_cast<int8_t>(ex + 1);
+        return *this;
     }
-    m = next;
+    m = static_cast<uint32_t>(hi) << 16 | static_cast<uint16_t>(q);
     e = ex;
     return *this;
 }
@@ -597,8 +738,8 @@ Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask) {
         if (static_cast<uint8_t>(v[i] >> 24) >= 0x40) drop = 2;
     }
     uint32_t hi = 0, lo = 0;
-    for (uint8_t i = 0; i < n; ++i, mask >>= 1) {
-        uint32_t x = v[i];
+    for (; n != 0; --n, ++v, mask >>= 1) {
+        uint32_t x = *v;
         if (x == 0 || !(mask & 1)) continue;
         if (drop) x >>= 2;
         uint32_t l, h = mul64(x, x, l);

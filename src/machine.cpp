@@ -13,9 +13,9 @@ void machine_build(Machine& m, const Settings& s) {
         m.um_q8_per_step[a].set(256000000ul).div(spm[a]);
     }
     for (uint8_t a = 0; a < kAxes; ++a) {
-        uint8_t mask = 0;
-        for (uint8_t b = 0; b < kAxes; ++b) {
-            if (s.axis_group[b] == s.axis_group[a]) mask = static_cast<uint8_t>(mask | (1u << b));
+        uint8_t mask = 0, bit = 1;
+        for (uint8_t b = 0; b < kAxes; ++b, bit = static_cast<uint8_t>(bit << 1)) {
+            if (s.axis_group[b] == s.axis_group[a]) mask = static_cast<uint8_t>(mask | bit);
         }
         m.group_of[a] = mask;
     }

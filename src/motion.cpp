@@ -11,14 +11,16 @@ namespace ll {
 namespace motion {
 namespace {
 
+// No default member initialisers: a zero-filled static object needs no constructor (init()
+// sets every field).
 struct Motion {
+    State state;
+    bool begun;          ///< the planner's first move is in the step generator
+    bool enabled;        ///< stepper drivers enabled
+    uint16_t idle_since; ///< hal::millis() when motion last stopped, low 16 bits ($1 <= 254 ms)
     Machine machine;
     Planner planner;
     StepGen gen;
-    State state = State::Idle;
-    bool begun = false;      ///< the planner's first move is in the step generator
-    bool enabled = false;    ///< stepper drivers enabled
-    uint32_t idle_since = 0; ///< hal::millis() when motion last stopped
 };
 
 Motion g_motion;
@@ -27,21 +29,19 @@ inline Motion& mo() {
     return g_motion;
 }
 
-void begin_next(Motion& m) {
-    while (!m.begun && !m.planner.empty()) {
-        if (m.gen.begin(m.planner.spec_of_first())) {
-            m.planner.begin_first();
-            m.begun = true;
-        } else {
-            m.planner.discard_first();
-        }
-    }
-}
-
+// Hands the planner's moves to the step generator and lets it fill the run queue, until the
+// queue is full, a hold stops it or nothing is left.
 void produce(Motion& m) {
     for (;;) {
-        begin_next(m);
-        if (!m.begun) return;
+        if (!m.begun) {
+            if (m.planner.empty()) return;
+            if (!m.gen.begin(m.planner.spec_of_first())) { // no step: drop it
+                m.planner.discard_first();
+                continue;
+            }
+            m.planner.begin_first();
+            m.begun = true;
+        }
         m.gen.set_exit(m.planner.exit2_of_first());
         m.gen.fill(g_runs);
         if (m.gen.active() || m.gen.stopped()) return; // queue full, or held
@@ -54,7 +54,9 @@ bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) {
         // Positions stay within +-2^30 steps (the G-code layer's range check), so the
         // difference cannot overflow.
-        if (abs32(to[a] - from[a]) > kMaxLineTicks) return true;
+        // |d| > kMaxLineTicks as one unsigned comparison: d + max wraps above 2 max.
+        uint32_t d = static_cast<uint32_t>(to[a] - from[a]) + kMaxLineTicks;
+        if (d > 2u * kMaxLineTicks) return true;
     }
     return false;
 }
@@ -63,40 +65,47 @@ bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
 // the machine is between targets; the next move's direction is taken from here).
 void position_um(Motion& m, const int32_t steps[kAxes], int32_t um[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) {
-        int32_t s = steps[a];
-        uint32_t mag = s < 0 ? static_cast<uint32_t>(-(s + 1)) + 1u : static_cast<uint32_t>(s);
-        int32_t v = static_cast<int32_t>(m.machine.um_q8_per_step[a].of(mag) >> 8);
-        um[a] = s < 0 ? -v : v;
+        uint32_t v = m.machine.um_q8_per_step[a].of(abs32(steps[a])) >> 8;
+        um[a] = static_cast<int32_t>(steps[a] < 0 ? 0u - v : v);
     }
 }
 
-void reset_planner(Motion& m, const int32_t here[kAxes]) {
+__attribute__((noinline)) void reset_planner(Motion& m, const int32_t here[kAxes]) {
     int32_t um[kAxes];
     position_um(m, here, um);
     m.planner.reset(here, um);
 }
 
-void enable(Motion& m, bool on) {
+__attribute__((noinline)) void enable(Motion& m, bool on) {
     if (m.enabled == on) return;
     m.enabled = on;
     hal::stepper_enable(on);
 }
 
-} // namespace
+__attribute__((noinline)) void go_idle(Motion& m) {
+    m.state = State::Idle;
+    m.idle_since = static_cast<uint16_t>(hal::millis());
+}
 
-void init() {
-    Motion& m = mo();
+// Stops the step timer, forgets every queued run and move; the machine is at `here`, steps.
+void restart(Motion& m, const int32_t here[kAxes]) {
     hal::stepper_stop();
     g_runs.clear();
     m.gen.clear_queue_time();
     g_exec.starved = 0;
-    int32_t zero[kAxes] = {};
     m.gen.abort();
-    m.gen.set_position(zero);
-    m.planner.reset(zero, zero);
+    m.gen.set_position(here);
+    reset_planner(m, here);
     m.begun = false;
-    m.enabled = false;
-    m.state = State::Idle;
+    go_idle(m);
+}
+
+} // namespace
+
+void init() {
+    int32_t zero[kAxes] = {};
+    restart(mo(), zero);
+    mo().enabled = false;
     g_starvations = 0;
 }
 
@@ -131,14 +140,15 @@ void poll() {
     Motion& m = mo();
     if (m.state == State::Idle && m.planner.empty() && g_runs.empty() && !g_exec.running) {
         if (m.enabled && g_settings.idle_delay_ms != 255 &&
-            hal::millis() - m.idle_since >= g_settings.idle_delay_ms) {
+            static_cast<uint16_t>(hal::millis() - m.idle_since) >= g_settings.idle_delay_ms) {
             enable(m, false);
         }
         return;
     }
     produce(m);
+    bool pending = m.begun || !m.planner.empty(); // a move is left to produce
     if (!g_exec.running) {
-        if (g_exec.starved && (m.begun || !m.planner.empty()) && !m.gen.stopped()) {
+        if (g_exec.starved && pending && !m.gen.stopped()) {
             g_starvations = static_cast<uint16_t>(g_starvations + 1); // dry mid-move
         }
         g_exec.starved = 0;
@@ -147,14 +157,11 @@ void poll() {
             hal::stepper_start();
         }
     }
-    bool drained = g_runs.empty() && !g_exec.running;
+    if (!g_runs.empty() || g_exec.running) return; // not drained
     if (m.state == State::Holding) {
-        if (drained && (m.gen.stopped() || (!m.begun && m.planner.empty()))) m.state = State::Held;
-    } else if (m.state == State::Cycle) {
-        if (drained && !m.begun && m.planner.empty()) {
-            m.state = State::Idle;
-            m.idle_since = hal::millis();
-        }
+        if (m.gen.stopped() || !pending) m.state = State::Held;
+    } else if (m.state == State::Cycle && !pending) {
+        go_idle(m);
     }
 }
 
@@ -164,16 +171,16 @@ State state() {
 
 void feed_hold() {
     Motion& m = mo();
-    if (m.state == State::Idle) {
-        // GRBL 1.1: a hold while idle is a complete hold. Moves sent meanwhile are planned
-        // (full look-ahead) but none starts until cycle start: the generator, holding at zero
-        // speed, stops at the first segment of any move it is given.
-        m.gen.hold();
+    State s = m.state;
+    if (s != State::Idle && s != State::Cycle) return;
+    // GRBL 1.1: a hold while idle is a complete hold. Moves sent meanwhile are planned (full
+    // look-ahead) but none starts until cycle start: the generator, holding at zero speed, stops
+    // at the first segment of any move it is given.
+    m.gen.hold();
+    if (s == State::Idle) {
         m.state = State::Held;
         return;
     }
-    if (m.state != State::Cycle) return;
-    m.gen.hold();
     m.state = State::Holding;
     poll();
 }
@@ -187,52 +194,45 @@ void cycle_start() {
     } else {
         m.gen.resume(0);
     }
-    m.state = (m.begun || !m.planner.empty()) ? State::Cycle : State::Idle;
-    if (m.state == State::Idle) m.idle_since = hal::millis();
+    if (m.begun || !m.planner.empty()) {
+        m.state = State::Cycle;
+    } else {
+        go_idle(m);
+    }
     poll();
 }
 
 bool abort() {
-    Motion& m = mo();
     bool moving = g_exec.running != 0;
     int32_t here[kAxes];
     position(here);
-    hal::stepper_stop();
-    g_runs.clear();
-    m.gen.clear_queue_time();
-    g_exec.starved = 0;
-    m.gen.abort();
-    m.gen.set_position(here);
-    reset_planner(m, here);
-    m.begun = false;
-    m.state = State::Idle;
-    m.idle_since = hal::millis();
+    restart(mo(), here);
     return moving;
 }
 
 void position(int32_t steps[kAxes]) {
     Motion& m = mo();
-    uint8_t head, remaining, cur_steps, cur_dirs;
+    uint8_t i, n, s, d;
     {
         hal::Critical cs;
-        head = g_runs.head;
-        remaining = g_exec.remaining;
-        cur_steps = g_exec.steps;
-        cur_dirs = g_exec.dirs;
+        i = g_runs.head;
+        n = g_exec.remaining;
+        s = g_exec.steps;
+        d = g_exec.dirs;
     }
     m.gen.pushed_position(steps);
     // Undo what is queued but not executed: the rest of the current run, then every run
     // between the consumer and the producer.
-    auto undo = [&](uint8_t s, uint8_t d, uint8_t n) {
+    for (;;) {
         for (uint8_t a = 0; a < kAxes; ++a, s >>= 1, d >>= 1) {
-            if (s & 1) steps[a] += (d & 1) ? n : -static_cast<int32_t>(n);
+            if (s & 1) steps[a] += (d & 1) ? n : -static_cast<int16_t>(n);
         }
-    };
-    undo(cur_steps, cur_dirs, remaining);
-    for (uint8_t i = head; i != g_runs.tail;
-         i = static_cast<uint8_t>((i + 1) & (kRunQueueSize - 1))) {
+        if (i == g_runs.tail) return;
         const Run& r = g_runs.buf[i];
-        undo(r.steps, r.dirs, r.count);
+        s = r.steps;
+        d = r.dirs;
+        n = r.count;
+        i = static_cast<uint8_t>((i + 1) & (kRunQueueSize - 1));
     }
 }
 

@@ -1,6 +1,7 @@
 // Decimal parsing and exact fixed-point scaling. See numparse.h.
 #include "lowlevel/numparse.h"
 
+#include "lowlevel/fixmath.h"
 #include "lowlevel/pgm.h"
 
 namespace ll {
@@ -66,18 +67,19 @@ const char* parse(const char* p, Decimal& out) {
 }
 
 bool length_to_milli(const Decimal& d, bool inches, int32_t& out) {
-    uint32_t m;
+    // ipart x unit + what the decimals make, with one multiplication and one range check.
+    uint16_t unit = 1000;
+    uint32_t limit = kInt32Max / 1000, decimals = d.frac + (d.sub >= 50 ? 1u : 0u);
     if (inches) {
         // 25400 per inch; the five decimals are 1e-5 in = 0.254 units of the result.
-        if (d.ipart > kInt32Max / 25400) return false;
+        unit = 25400;
+        limit = kInt32Max / 25400;
         uint32_t frac5 =
             static_cast<uint32_t>(d.frac) * 100u + d.sub + ((d.flags & Decimal::kRound6) ? 1u : 0u);
-        m = d.ipart * 25400u + (frac5 * 254u + 500u) / 1000u;
-    } else {
-        if (d.ipart > kInt32Max / 1000) return false;
-        m = d.ipart * 1000u + d.frac + (d.sub >= 50 ? 1u : 0u);
+        decimals = (frac5 * 254u + 500u) / 1000u;
     }
-    return finish(d.negative(), m, out);
+    if (d.ipart > limit) return false;
+    return finish(d.negative(), d.ipart * unit + decimals, out);
 }
 
 bool to_uint(const Decimal& d, uint32_t max, uint32_t& out) {
@@ -155,15 +157,7 @@ inline void divide(uint32_t& r, uint32_t& q, uint32_t c) {
 bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out) {
     bool negative = a < 0;
     uint32_t m = negative ? 0u - static_cast<uint32_t>(a) : static_cast<uint32_t>(a);
-    // The halves of the product through a union (both targets are little-endian): 64-bit
-    // shifts would be library calls on the chip.
-    union {
-        uint64_t v;
-        uint32_t w[2];
-    } p;
-    static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "w[0] is the low half");
-    p.v = static_cast<uint64_t>(m) * b;
-    uint32_t q = p.w[0], r = p.w[1];
+    uint32_t q, r = mul_wide(m, b, q); // the exact product r * 2^32 + q
     // + c/2: half away from zero on the magnitude.
     uint32_t half = c >> 1;
     q += half;

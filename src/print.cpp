@@ -26,14 +26,14 @@ void digits(uint32_t m, uint8_t decimals) {
         }
         if (d != '0' || p <= decimals) started = true;
         if (!started) continue;
-        if (p + 1 == decimals) ch('.');
+        if (static_cast<uint8_t>(p + 1) == decimals) ch('.');
         ch(d);
     } while (p != 0);
 }
 
 // value x mul / div, rounded half away from zero, printed with `decimals` decimals.
 void scaled(int32_t v, uint8_t mul, uint16_t div, uint8_t decimals) {
-    if (div != 1) num::mul_div_round(v, mul, div, v);
+    num::mul_div_round(v, mul, div, v); // div > 1 at every call
     fixed(v, decimals);
 }
 } // namespace
@@ -94,9 +94,12 @@ void coord(int32_t um) {
 }
 
 void coords(const int32_t* um) {
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        if (a != 0) ch(',');
-        coord(um != nullptr ? um[a] : 0);
+    for (uint8_t a = kAxes;;) {
+        int32_t v = 0;
+        if (um != nullptr) v = *um++;
+        coord(v);
+        if (--a == 0) return;
+        ch(',');
     }
 }
 

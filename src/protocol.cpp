@@ -156,14 +156,15 @@ __attribute__((noinline)) void report_status() {
 
 // `$N=value`.
 uint8_t store_setting() {
-    uint8_t i = 1;
     num::Decimal n, v;
-    if (!num::parse(p.line, i, n)) return kBadNumberFormat;
-    if (p.line[i++] != '=') return kInvalidStatement;
+    const char* s = num::parse(p.line + 1, n);
+    if (s == nullptr) return kBadNumberFormat;
+    if (*s++ != '=') return kInvalidStatement;
     uint32_t number;
     if (!num::to_uint(n, 255u, number)) return kInvalidStatement;
-    if (!num::parse(p.line, i, v)) return kBadNumberFormat;
-    if (p.line[i] != 0) return kInvalidStatement;
+    s = num::parse(s, v);
+    if (s == nullptr) return kBadNumberFormat;
+    if (*s != 0) return kInvalidStatement;
     uint8_t r = settings::store(static_cast<uint8_t>(number), v);
     if (r == kOk) {
         motion::settings_changed();

@@ -157,7 +157,10 @@ uint8_t store(uint8_t n, const num::Decimal& value) {
             memcpy(f, &milli, sizeof(milli));
         } else {
             uint32_t v;
-            uint8_t max = kind == kBool ? 1 : kind == kGroup ? kAxes - 1 : 255;
+            static_assert(kByte == 0 && kBool == 1 && kPulse == 2 && kGroup == 3 && kMilli == 4,
+                          "kMax follows the kinds");
+            static const uint8_t kMax[kMilli] LL_PROGMEM = {255, 1, 255, kAxes - 1}; // by kind
+            uint8_t max = flash_read_byte(&kMax[kind]);
             if (!num::to_uint(value, max, v)) return status::kInvalidStatement;
             if (kind == kPulse && v < 3) return status::kStepPulseMin;
             *f = static_cast<uint8_t>(v);

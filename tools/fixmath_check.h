@@ -91,6 +91,17 @@ inline uint32_t fixmath_hash(uint16_t rounds) {
         h.add(z.of(b) ^ x.of(0));
         h.add(Num(y).mul(b >> (xorshift(s) & 31)));
         h.add(Num(y).div(a >> (xorshift(s) & 31)));
+        h.add(shl_sat(any(s), static_cast<uint8_t>(xorshift(s) % 40)));
+        h.add(Num(x).mulc(a | 0x80000000ul,
+                          static_cast<int8_t>(static_cast<int16_t>(xorshift(s) % 100) - 50)));
+        // atan2 in every quadrant, on both axes and at every magnitude (|v| < 2^30).
+        int32_t ya = static_cast<int32_t>(any(s) >> 2), xa = static_cast<int32_t>(any(s) >> 2);
+        uint32_t signs = xorshift(s);
+        if (signs & 1) ya = -ya;
+        if (signs & 2) xa = -xa;
+        if ((signs & 0x1C) == 0) ya = 0;
+        if ((signs & 0xE0) == 0) xa = 0;
+        h.add(static_cast<uint32_t>(atan2_q29(ya, xa)));
     }
     return h.h;
 }
