@@ -49,6 +49,8 @@ struct Job {
     /// reports take the receive interrupt and the main loop's critical sections; the model's
     /// edges do not depend on them.
     uint32_t status_every_ms = 0;
+    /// Longest the job may run, simulated seconds (a job still moving then is an error).
+    uint32_t limit_s = 5;
 };
 
 /// What one side did with a job.
