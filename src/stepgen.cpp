@@ -491,9 +491,6 @@ void StepGen::fill_curve(RunQueue& q) {
     while (active_ && !stopped_) {
         // Worst case of one segment: every sample its own run, each possibly split in two; a
         // segment is cut short to what the queue can take.
-        const uint8_t free = q.free_slots();
-        if (free < 4) break;
-        const uint8_t cap = static_cast<uint8_t>((free - 2) / 2);
         if (horizon_full(q)) break;
         // The chord of the next sample sets the time of every sample of the segment (the
         // segment never crosses into the next piece, whose samples may be twice as long).
@@ -509,8 +506,14 @@ void StepGen::fill_curve(RunQueue& q) {
         // mm over 2^16 -> µm x 256
         uint32_t chord_q8 = sum.sqrt().mul(256000).shift(-16).u32();
         if (chord_q8 == 0) chord_q8 = 1;
-        uint8_t n = seg_len_ < cap ? seg_len_ : cap;
+        // The segment's length depends on the speed only, never on how full the queue is (the
+        // chip and the host model must cut the same segments): wait for room for all of it.
+        // At most 3 samples (6 runs in the worst case), so that the queue is still half full
+        // when there is room for a whole segment.
+        constexpr uint8_t kMaxSamples = 3;
+        uint8_t n = seg_len_ < kMaxSamples ? seg_len_ : kMaxSamples;
         if (left != 0 && left < n) n = static_cast<uint8_t>(left);
+        if (q.free_slots() < 2 * n + 2) break;
         uint32_t mid = cv_.x_q8 + chord_q8 * n / 2;
         uint32_t delta;
         if (!delta_at(2 * ((mid >> 8) - origin_), delta)) break;
@@ -543,7 +546,9 @@ void StepGen::fill_curve(RunQueue& q) {
 #if LL_STATS
         ++stats.segments;
 #endif
-        seg_len_ = next_segment(period_q8 < 1 ? 1 : period_q8, period_q8);
+        // A curve segment costs a chord (a square root) on top of its samples: 8x the line
+        // segment duration keeps that cost to a fraction of the time the samples take.
+        seg_len_ = next_segment(period_q8 < 8 ? 1 : period_q8 >> 3, period_q8);
         if (cv_.w.done()) finish_move();
     }
 }
