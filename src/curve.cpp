@@ -131,6 +131,10 @@ inline void fd_step(int64_t v[4]) {
 #endif
 }
 
+// The terms of the initial forward differences (start_piece): difference index << 4 |
+// multiplier / 2 << 2 (0: 1) | power of 1/N.
+const uint8_t kTerms[6] LL_PROGMEM = {0x11, 0x12, 0x13, 0x26, 0x2F, 0x3F};
+
 // acc += n x / 2^s in Q40 for x in Q8 (n x below 2^31, s <= 36): exact for s <= 32, floored
 // beyond.
 __attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s, uint8_t n) {
@@ -197,24 +201,25 @@ void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const 
     }
     // N = 2^m > bound (ticks): at most one tick per sample and axis.
     uint8_t m = 0;
-    while ((1ul << (m + 8)) <= bound) ++m;
+    for (uint32_t b = bound >> 8; b != 0; b >>= 1) ++m;
     left_ = static_cast<uint16_t>(1u << m);
     uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
     for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
-    const uint8_t m2 = static_cast<uint8_t>(2 * m), m3 = static_cast<uint8_t>(3 * m);
     for (uint8_t a = 0; a < 3; ++a) {
         int64_t* v = fd_[a];
-        const int32_t* k = c[a];
         base_[a] = prev_q8_[a] >> 8;
+        // f: the fraction of a tick where the piece starts, in the high word.
+        const int32_t frac = prev_q8_[a] & 0xFF;
+        memcpy(reinterpret_cast<uint8_t*>(v) + 4, &frac, 4);
         // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
-        // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3.
-        add_q40(v[0], prev_q8_[a] & 0xFF, 0, 1);
-        add_q40(v[1], k[0], m, 1);
-        add_q40(v[1], k[1], m2, 1);
-        add_q40(v[1], k[2], m3, 1);
-        add_q40(v[2], k[1], m2, 2);
-        add_q40(v[2], k[2], m3, 6);
-        add_q40(v[3], k[2], m3, 6);
+        // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3. Terms: difference, power of 1/N (and coefficient
+        // c_power), multiplier.
+        for (uint8_t i = 0; i < 6; ++i) {
+            const uint8_t t = flash_read_byte(&kTerms[i]);
+            const uint8_t pw = t & 3;
+            add_q40(v[t >> 4], c[a][pw - 1], static_cast<uint8_t>(pw * m),
+                    (t >> 2) & 3 ? ((t >> 2) & 3) * 2 : 1);
+        }
         prev_q8_[a] = p3[a];
     }
 }
