@@ -170,13 +170,11 @@ int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clock
 }
 
 void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
-    for (uint8_t a = 0; a < 3; ++a) {
-        pos[a] = e.start[a];
-        end_[a] = e.end[a];
-        prev_q8_[a] = a < 2 ? p0_q8[a] : e.start[2] * 256;
-    }
+    memcpy(pos, e.start, sizeof(pos));
+    memcpy(end_, e.end, sizeof(end_));
+    memcpy(prev_q8_, p0_q8, 2 * sizeof(prev_q8_[0]));
     // w moves linearly along the curve (a helix); without it, only u and v are walked.
-    w0_q8_ = prev_q8_[2];
+    prev_q8_[2] = w0_q8_ = e.start[2] * 256;
     dw_q8_ = e.end[2] * 256 - w0_q8_;
     axes_ = dw_q8_ ? 3 : 2;
     kind_ = kind;
@@ -542,9 +540,10 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
 // end, and these crowd where the curve turns tightly.
 Num track_length(Track& k, uint32_t span, uint32_t widest) {
     Num total{};
-    uint32_t w;
-    probe(k, 0, false, &w);
+    uint32_t half;
+    probe(k, 0, false, &half);
     while (span != 0) {
+        uint32_t w = half; // in a register: half's address is taken
         if (w > widest) w = widest;
         if (w < kNarrowestQ29) w = kNarrowestQ29;
         if (w > span) w = span;
@@ -554,7 +553,7 @@ Num track_length(Track& k, uint32_t span, uint32_t widest) {
         sum.add(probe(k, w - g, false, nullptr)).mul(5).add(probe(k, w / 2, false, nullptr).mul(8));
         total.add(sum.mul(w));
         span -= w;
-        probe(k, w, true, &w);
+        probe(k, w, true, &half);
     }
     return total;
 }

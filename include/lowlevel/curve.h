@@ -116,20 +116,19 @@ class CurveWalker {
     void arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const;
     void bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const;
 
-    // Current piece, per axis: the position and its forward differences (f, d1, d2, d3), Q40
-    // ticks relative to base_.
-    int64_t fd_[3][4];
-    int32_t base_[3];
-    uint16_t left_;
+    // The small fields first, the forward differences last: on the ATmega328P a field within 63
+    // bytes of the object is reached by displacement, one beyond costs a pointer computation.
+    uint16_t left_; ///< samples left in the current piece
     // Curve
     uint8_t kind_;          ///< 0 done, 1 arc, 2 bezier
     uint8_t axes_;          ///< axes walked: 2 (u, v), or 3 when w moves (a helix)
     uint16_t pieces_;       ///< pieces not started yet
     uint16_t piece_count_;  ///< pieces in the curve
-    int32_t end_[3];        ///< final position, ticks
-    int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
-    int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
     uint8_t log_pieces_;    ///< Bezier: 2^j pieces
+    int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
+    int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
+    int32_t end_[3];        ///< final position, ticks
+    int32_t base_[3];       ///< the current piece's start, ticks (fd_ is relative to it)
     // An arc or a Bezier, never both.
     struct ArcState {
         int32_t centre[2];
@@ -142,6 +141,9 @@ class CurveWalker {
         ArcState a_;
         int32_t pts_[2][4]; ///< Bezier: control points, u then v, ticks x 256
     };
+    // Current piece, per axis: the position and its forward differences (f, d1, d2, d3), Q40
+    // ticks relative to base_.
+    int64_t fd_[3][4];
 };
 
 } // namespace ll
