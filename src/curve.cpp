@@ -64,18 +64,26 @@ void rotate(int32_t v[2], const int32_t rot[2]) {
     v[0] = c;
 }
 
-// sqrt(a^2 + b^2 + cc).
-Num hypot(Num a, Num b, const Num& cc) {
-    a.mul(a);
-    b.mul(b);
-    return a.add(b).add(cc).sqrt();
+// sqrt(q0^2 + ... + q(n-1)^2).
+__attribute__((noinline)) Num root_sum_squares(const Num* q, uint8_t n) {
+    Num sum{};
+    for (uint8_t i = 0; i < n; ++i) {
+        Num t = q[i];
+        sum.add(t.mul(q[i]));
+    }
+    return sum.sqrt();
 }
 
-// num / den as a signed fixed-point value with `bits` fraction bits, at most 1 in magnitude.
-__attribute__((noinline)) int32_t unit_part(Num num, const Num& den, bool negative, uint8_t bits) {
-    uint32_t u = num.div(den).shift(static_cast<int8_t>(bits)).u32();
-    if (u > (1ul << bits)) u = 1ul << bits;
-    return negative ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+// out[i] = q[i] / |q| for the n components of q, `bits` fraction bits, negated where bit i of
+// `neg` is set; 0 for q = 0 (a quotient by zero is zero).
+__attribute__((noinline)) void unit_vector(const Num* q, uint8_t n, uint8_t neg, uint8_t bits,
+                                           int32_t* out) {
+    const Num norm = root_sum_squares(q, n);
+    for (uint8_t i = 0; i < n; ++i) {
+        uint32_t u = Num(q[i]).div(norm).shift(static_cast<int8_t>(bits)).u32();
+        if (u > (1ul << bits)) u = 1ul << bits;
+        out[i] = (neg >> i) & 1 ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+    }
 }
 
 // |sweep| in (0, 2 pi] from the angle a0 to the angle a1 (radians x 2^29, in (-pi, pi]),
@@ -96,12 +104,13 @@ uint32_t sweep_q29(int32_t a0, int32_t a1, bool clockwise) {
 uint32_t arc_directions(const int32_t start[2], const int32_t end[2], const int32_t centre[2],
                         const uint32_t radii[2], bool clockwise, int32_t dir[2][2]) {
     const int32_t* pt[2] = {start, end};
-    int32_t a[2];
     for (uint8_t i = 0; i < 2; ++i) {
         ellipse_direction(pt[i][0] - centre[0], pt[i][1] - centre[1], radii, dir[i][0], dir[i][1]);
-        a[i] = atan2_q29(dir[i][1], dir[i][0]);
     }
-    return sweep_q29(a[0], a[1], clockwise);
+    // The signed sweep's low word (its magnitude is below 2^32).
+    const uint32_t sweep = static_cast<uint32_t>(
+        arc_sweep_q29(dir[0][0], dir[0][1], dir[1][0], dir[1][1], clockwise, 0));
+    return clockwise ? 0u - sweep : sweep;
 }
 
 // One sample of a cubic by forward differencing: f += d1, d1 += d2, d2 += d3 (v = f, d1, d2, d3).
@@ -157,9 +166,10 @@ void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], i
     const int32_t v[2] = {x_q8, y_q8};
     Num q[2];
     for (uint8_t k = 0; k < 2; ++k) q[k] = Num(abs32(v[k])).div(radii_q8[k]);
-    Num n = hypot(q[0], q[1], Num{});
-    c = unit_part(q[0], n, x_q8 < 0, 30);
-    s = unit_part(q[1], n, y_q8 < 0, 30);
+    int32_t u[2];
+    unit_vector(q, 2, static_cast<uint8_t>((x_q8 < 0) | (y_q8 < 0) << 1), 30, u);
+    c = u[0];
+    s = u[1];
 }
 
 int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clockwise,
@@ -412,6 +422,7 @@ struct Track {
     bool bezier;
     bool clockwise; ///< ellipse: the angle decreases
     bool w_down;    ///< w decreases along the curve
+    bool w_counts;  ///< w's travel counts in the length
     union {
         struct {
             int32_t r[2];      ///< radii
@@ -423,7 +434,6 @@ struct Track {
         } b;                 ///< Bezier
     };
     Num rise; ///< |dw / dparameter|: the helix' rise
-    Num ww;   ///< rise^2 when w counts in the length, else 0
     Num rmin; ///< Bezier: smallest radius of curvature met so far (0: none)
 };
 
@@ -485,9 +495,10 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
     }
 }
 
-// |(x, y)| with z2 added under the root, for signed x, y.
-Num norm(const int32_t v[2], const Num& z2) {
-    return hypot(Num(abs32(v[0])), Num(abs32(v[1])), z2);
+// |(x, y)| for signed x, y, or with `with_rise` |(x, y, rise)|.
+Num norm(const int32_t v[2], const Track& k, bool with_rise) {
+    const Num q[3] = {Num(abs32(v[0])), Num(abs32(v[1])), k.rise};
+    return root_sum_squares(q, with_rise ? 3 : 2);
 }
 
 // The unit tangent (P', w') / |(P', w')| at the current point, Q29. Where P' = 0 (a Bezier whose
@@ -500,12 +511,8 @@ void tangent(Track& k, int32_t out[3]) {
         const uint32_t in = kOneQ29 >> 12; // backwards from t = 1: modulo 2^32
         track_at(k, k.b.t ? static_cast<uint32_t>(0u - in) : in, false, d, d2);
     }
-    Num x(abs32(d[0])), y(abs32(d[1])), rr = k.rise;
-    Num n = hypot(x, y, rr.mul(k.rise));
-    if (n.m == 0) return; // out stays 0
-    out[0] = unit_part(x, n, d[0] < 0, 29);
-    out[1] = unit_part(y, n, d[1] < 0, 29);
-    out[2] = unit_part(k.rise, n, k.w_down, 29);
+    const Num q[3] = {Num(abs32(d[0])), Num(abs32(d[1])), k.rise};
+    unit_vector(q, 3, static_cast<uint8_t>((d[0] < 0) | (d[1] < 0) << 1 | k.w_down << 2), 29, out);
 }
 
 // The track at `off` (Q29) past its current point, which with `move` becomes the current one:
@@ -515,7 +522,7 @@ void tangent(Track& k, int32_t out[3]) {
 Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
     int32_t d1[2], d2[2];
     track_at(k, off, move, d1, d2);
-    Num n1 = norm(d1, Num{});
+    Num n1 = norm(d1, k, false);
     if (k.bezier) {
         // |P' x P''| / 2^30: both are below 2^30, and where the radius is smallest this keeps 20
         // bits.
@@ -527,10 +534,10 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
         }
     }
     if (half) {
-        Num n2 = norm(d2, Num{});
+        Num n2 = norm(d2, k, false);
         *half = n2.m ? Num(n1).div(n2).shift(28).u32() : 0xFFFFFFFFul; // P'' = 0: a line
     }
-    return k.ww.m ? norm(d1, k.ww) : n1;
+    return k.w_counts ? norm(d1, k, true) : n1;
 }
 
 // Length of the track over `span` (Q29) from its current point, x 2^29 x 18 x 2^scale: panels
@@ -587,7 +594,10 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
         circle = lo == hi;
         len.mul(lo); // a circle: r |sweep|, and a helix: sqrt(plane^2 + dw^2)
-        if (w_regulated) len = hypot(len, Num(abs32(dw_um)), Num{});
+        if (w_regulated) {
+            const Num q[2] = {len, Num(abs32(dw_um))};
+            len = root_sum_squares(q, 2);
+        }
     } else {
         // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
@@ -604,10 +614,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         k.rise = Num(abs32(dw_um));
     }
     k.rise.shift(scale);
-    if (w_regulated) {
-        k.ww = k.rise;
-        k.ww.mul(k.rise);
-    }
+    k.w_counts = w_regulated;
     tangent(k, out.start_dir);
     if (!circle) { // ellipses and Beziers by quadrature
         len = track_length(k, span, widest);
