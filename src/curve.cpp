@@ -440,9 +440,7 @@ struct Track {
 // Shifts v[0..n-1] left or right so that the largest magnitude is in [2^27, 2^28); the shift.
 int8_t normalise(int32_t* v, uint8_t n) {
     uint32_t big = 0;
-    for (uint8_t i = 0; i < n; ++i) {
-        if (abs32(v[i]) > big) big = abs32(v[i]);
-    }
+    for (uint8_t i = 0; i < n; ++i) big |= abs32(v[i]); // the largest's top bit
     int8_t sh = 0;
     if (big == 0) return 0;
     while (big >= (1ul << 28)) {
