@@ -372,7 +372,8 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
             break;
         }
     }
-    for (uint8_t a = 0; a < 3; ++a) {
+    uint8_t bit = 1;
+    for (uint8_t a = 0; a < 3; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         int32_t p = end_[a];
         if (kind_ != 0) {
             if (a == axes_) break;
@@ -385,7 +386,6 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
             p = base_[a] + ((hi + 128) >> 8);
         }
         if (p != pos[a]) {
-            const uint8_t bit = static_cast<uint8_t>(1u << a);
             moved = static_cast<uint8_t>(moved | bit);
             if (p < pos[a]) neg = static_cast<uint8_t>(neg | bit);
             pos[a] = p;
@@ -573,6 +573,8 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     uint8_t turns = 0;
     bool circle = false;
     Num len{};
+    // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
+    k.rise = Num(abs32(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
         if (r[0] == 0 || r[1] == 0) return false;
@@ -583,9 +585,9 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         turns = cp.turns;
         len = Num(kTurnQ29, -29).mul(turns).add(Num(span, -29));
         // w rises linearly with the angle: dw / |sweep| per radian.
-        k.rise = Num(abs32(dw_um)).div(len);
-        k.e.r[0] = static_cast<int32_t>(r[0]);
-        k.e.r[1] = static_cast<int32_t>(r[1]);
+        const Num dw = k.rise;
+        k.rise.div(len);
+        memcpy(k.e.r, r, sizeof(k.e.r));
         scale = normalise(k.e.r, 2);
         const uint32_t lo = r[0] < r[1] ? r[0] : r[1];
         const uint32_t hi = r[0] ^ r[1] ^ lo;
@@ -593,7 +595,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         circle = lo == hi;
         len.mul(lo); // a circle: r |sweep|, and a helix: sqrt(plane^2 + dw^2)
         if (w_regulated) {
-            const Num q[2] = {len, Num(abs32(dw_um))};
+            const Num q[2] = {len, dw};
             len = root_sum_squares(q, 2);
         }
     } else {
@@ -609,7 +611,6 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         }
         scale = normalise(&k.b.h[0][0], 6);
         k.bezier = true;
-        k.rise = Num(abs32(dw_um));
     }
     k.rise.shift(scale);
     k.w_counts = w_regulated;
@@ -624,8 +625,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         out.min_radius_um =
             k.rmin.m ? k.rmin.shift(static_cast<int8_t>(-scale)).u32() : 0xFFFFFFFFul;
     } else {
-        k.e.dir[0][0] = k.e.dir[1][0];
-        k.e.dir[0][1] = k.e.dir[1][1];
+        memcpy(k.e.dir[0], k.e.dir[1], sizeof(k.e.dir[0]));
     }
     tangent(k, out.end_dir);
     if (len.m == 0) return false;
@@ -637,8 +637,8 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
 
 bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
     Track k{};
-    out.start_dir[0] = out.start_dir[1] = out.start_dir[2] = 0;
-    out.end_dir[0] = out.end_dir[1] = out.end_dir[2] = 0;
+    memset(out.start_dir, 0, sizeof(out.start_dir));
+    memset(out.end_dir, 0, sizeof(out.end_dir));
     return shape(cp, dw_um, w_regulated && dw_um != 0, out, k);
 }
 
