@@ -246,10 +246,8 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
                       bool clockwise, uint8_t turns) {
     kind_ = 0;
     if (radii_q8[0] == 0 || radii_q8[1] == 0) return false;
-    for (uint8_t k = 0; k < 2; ++k) {
-        a_.centre[k] = centre_q8[k];
-        a_.radii[k] = radii_q8[k];
-    }
+    memcpy(a_.centre, centre_q8, sizeof(a_.centre));
+    memcpy(a_.radii, radii_q8, sizeof(a_.radii));
     // Directions of the start and end points (their projections on the curve), and the sweep
     // with the extra turns, radians x 2^20 (below 2^31 for 255 turns).
     uint32_t mag =
@@ -282,7 +280,7 @@ void CurveWalker::bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) co
     // hull.
     for (uint8_t k = 0; k < 2; ++k) {
         int32_t q[4];
-        for (uint8_t i = 0; i < 4; ++i) q[i] = pts_[k][i];
+        memcpy(q, pts_[k], sizeof(q));
         for (uint8_t n = 3; n > 1; --n) {
             for (uint8_t i = 0; i < n; ++i) q[i] = lerp(q[i], q[i + 1], a_q20);
         }
@@ -342,10 +340,7 @@ bool CurveWalker::next_piece() {
         int32_t* dir = a_.dir[0];
         arc_at(dir, p3, arm0);
         rotate(dir, a_.rot);
-        if (last) { // land on the end point's direction: no drift left over
-            dir[0] = a_.dir[1][0];
-            dir[1] = a_.dir[1][1];
-        }
+        if (last) memcpy(dir, a_.dir[1], sizeof(a_.dir[1])); // no drift left over
         arc_at(dir, p3, arm3);
     } else {
         // Bezier part [a, a + 1/n]: the curve's ends and tangents.
@@ -471,16 +466,14 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
         }
         return;
     }
-    int32_t v[2] = {k.e.dir[0][0], k.e.dir[0][1]};
+    int32_t v[2];
+    memcpy(v, k.e.dir[0], sizeof(v));
     if (off) {
         int32_t rot[2], h = static_cast<int32_t>(off << 1);
         rotation(k.clockwise ? -h : h, rot);
         rotate(v, rot);
     }
-    if (move) {
-        k.e.dir[0][0] = v[0];
-        k.e.dir[0][1] = v[1];
-    }
+    if (move) memcpy(k.e.dir[0], v, sizeof(v));
     // (-ru sin t, rv cos t), reversed when clockwise, and (-ru cos t, -rv sin t) (only its size
     // is used).
     if (k.clockwise) {
