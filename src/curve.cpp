@@ -26,6 +26,11 @@ __attribute__((noinline)) int32_t mul_q30(int32_t a, int32_t b) {
     return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> 30);
 }
 
+// abs32 out of line: inline, each of its many uses costs 18 bytes on the AVR.
+__attribute__((noinline)) uint32_t mag(int32_t v) {
+    return abs32(v);
+}
+
 // Forward differences in place: (p0, p1, p2, p3) -> (p0, p1 - p0, p2 - 2 p1 + p0, p3 - 3 p2 + ...).
 void differences(int32_t q[4]) {
     for (uint8_t i = 1; i < 4; ++i) {
@@ -165,7 +170,7 @@ void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], i
                        int32_t& s) {
     const int32_t v[2] = {x_q8, y_q8};
     Num q[2];
-    for (uint8_t k = 0; k < 2; ++k) q[k] = Num(abs32(v[k])).div(radii_q8[k]);
+    for (uint8_t k = 0; k < 2; ++k) q[k] = Num(mag(v[k])).div(radii_q8[k]);
     int32_t u[2];
     unit_vector(q, 2, static_cast<uint8_t>((x_q8 < 0) | (y_q8 < 0) << 1), 30, u);
     c = u[0];
@@ -294,22 +299,18 @@ void CurveWalker::bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) co
 bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2_q8[2]) {
     kind_ = 0;
     uint32_t bound = 0; // hodograph bound (power basis), ticks
+    const int32_t* src[4] = {e.start_q8, p1_q8, p2_q8, e.end_q8};
     for (uint8_t k = 0; k < 2; ++k) {
-        int32_t* q = pts_[k];
-        q[0] = e.start_q8[k];
-        q[1] = p1_q8[k];
-        q[2] = p2_q8[k];
-        q[3] = e.end_q8[k];
         // B'(a) = 3 D1 + 6 D2 a + 3 D3 a^2 (D: the forward differences of the points, ticks).
         int32_t d[4];
-        for (uint8_t i = 0; i < 4; ++i) d[i] = q[i] >> 8;
+        for (uint8_t i = 0; i < 4; ++i) d[i] = (pts_[k][i] = src[i][k]) >> 8;
         differences(d);
-        uint32_t b = 3 * (abs32(d[1]) + 2 * abs32(d[2]) + abs32(d[3]));
+        uint32_t b = 3 * (mag(d[1]) + 2 * mag(d[2]) + mag(d[3]));
         if (b > bound) bound = b;
     }
     // 2^j pieces, each with a hodograph bound below kMaxPieceTicks (it shrinks with 2^j).
     uint8_t j = 0;
-    while ((bound >> j) >= kMaxPieceTicks) {
+    for (; bound >= kMaxPieceTicks; bound >>= 1) {
         if (j == 15) return false;
         ++j;
     }
@@ -435,7 +436,7 @@ struct Track {
 // Shifts v[0..n-1] left or right so that the largest magnitude is in [2^27, 2^28); the shift.
 int8_t normalise(int32_t* v, uint8_t n) {
     uint32_t big = 0;
-    for (uint8_t i = 0; i < n; ++i) big |= abs32(v[i]); // the largest's top bit
+    for (uint8_t i = 0; i < n; ++i) big |= mag(v[i]); // the largest's top bit
     int8_t sh = 0;
     if (big == 0) return 0;
     while (big >= (1ul << 28)) {
@@ -488,7 +489,7 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
 
 // |(x, y)| for signed x, y, or with `with_rise` |(x, y, rise)|.
 Num norm(const int32_t v[2], const Track& k, bool with_rise) {
-    const Num q[3] = {Num(abs32(v[0])), Num(abs32(v[1])), k.rise};
+    const Num q[3] = {Num(mag(v[0])), Num(mag(v[1])), k.rise};
     return root_sum_squares(q, with_rise ? 3 : 2);
 }
 
@@ -502,7 +503,7 @@ void tangent(Track& k, int32_t out[3]) {
         const uint32_t in = kOneQ29 >> 12; // backwards from t = 1: modulo 2^32
         track_at(k, k.b.t ? static_cast<uint32_t>(0u - in) : in, false, d, d2);
     }
-    const Num q[3] = {Num(abs32(d[0])), Num(abs32(d[1])), k.rise};
+    const Num q[3] = {Num(mag(d[0])), Num(mag(d[1])), k.rise};
     unit_vector(q, 3, static_cast<uint8_t>((d[0] < 0) | (d[1] < 0) << 1 | k.w_down << 2), 29, out);
 }
 
@@ -520,7 +521,7 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
         int32_t cross = mul_q30(d1[0], d2[1]) - mul_q30(d1[1], d2[0]);
         if (cross != 0) {
             Num rc = n1;
-            rc.mul(n1).mul(n1).div(abs32(cross)).shift(-30);
+            rc.mul(n1).mul(n1).div(mag(cross)).shift(-30);
             if (k.rmin.m == 0 || rc.cmp(k.rmin) < 0) k.rmin = rc;
         }
     }
@@ -567,7 +568,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     bool circle = false;
     Num len{};
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
-    k.rise = Num(abs32(dw_um));
+    k.rise = Num(mag(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
         if (r[0] == 0 || r[1] == 0) return false;
