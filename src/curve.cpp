@@ -475,14 +475,12 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
         rotate(v, rot);
     }
     if (move) memcpy(k.e.dir[0], v, sizeof(v));
-    // (-ru sin t, rv cos t), reversed when clockwise, and (-ru cos t, -rv sin t) (only its size
-    // is used).
-    if (k.clockwise) {
-        v[0] = -v[0];
-        v[1] = -v[1];
-    }
+    // (-ru sin t, rv cos t), reversed when clockwise, and (ru cos t, rv sin t) (-P'': only its
+    // size is used).
     for (uint8_t i = 0; i < 2; ++i) {
-        d1[i] = mul_q30(k.e.r[i], i ? v[0] : -v[1]);
+        int32_t a = v[1 - i];
+        if ((i != 0) == k.clockwise) a = -a;
+        d1[i] = mul_q30(k.e.r[i], a);
         d2[i] = mul_q30(k.e.r[i], v[i]);
     }
 }
