@@ -145,10 +145,6 @@ inline void fd_step(int64_t v[4]) {
 #endif
 }
 
-// The terms of the initial forward differences (start_piece): difference index << 4 |
-// multiplier / 2 << 2 (0: 1) | power of 1/N.
-const uint8_t kTerms[6] LL_PROGMEM = {0x11, 0x12, 0x13, 0x26, 0x2F, 0x3F};
-
 // acc += n x / 2^s in Q40 for x in Q8 (n x below 2^31, s <= 36): exact for s <= 32, floored
 // beyond.
 __attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s, uint8_t n) {
@@ -196,7 +192,7 @@ void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
     left_ = 0;
 }
 
-void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const int32_t arm3[3]) {
+void CurveWalker::start_piece(const Piece& g) {
     // The cubic from prev_q8_ (p0) to p3 whose control points are p0 + arm0 / 3 and
     // p3 - arm3 / 3, ticks x 256: relative to p0, c1 t + c2 t^2 + c3 t^3 with c1 = arm0,
     // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0.
@@ -204,9 +200,9 @@ void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const 
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
     for (uint8_t a = 0; a < 3; ++a) {
         int32_t* k = c[a];
-        const int32_t d = p3[a] - prev_q8_[a];
-        k[0] = arm0[a];
-        k[2] = arm0[a] + arm3[a] - 2 * d;
+        const int32_t d = g.p3[a] - prev_q8_[a];
+        k[0] = g.arm0[a];
+        k[2] = g.arm0[a] + g.arm3[a] - 2 * d;
         k[1] = d - k[0] - k[2];
         const uint32_t a2 = abs32(k[2]);
         const uint32_t b = abs32(k[0]) + 2 * (abs32(k[1]) + a2) + a2;
@@ -225,15 +221,14 @@ void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const 
         const int32_t frac = prev_q8_[a] & 0xFF;
         memcpy(reinterpret_cast<uint8_t*>(v) + 4, &frac, 4);
         // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
-        // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3. Terms: difference, power of 1/N (and coefficient
-        // c_power), multiplier.
-        for (uint8_t i = 0; i < 6; ++i) {
-            const uint8_t t = flash_read_byte(&kTerms[i]);
-            const uint8_t pw = t & 3;
-            add_q40(v[t >> 4], c[a][pw - 1], static_cast<uint8_t>(pw * m),
-                    (t >> 2) & 3 ? ((t >> 2) & 3) * 2 : 1);
+        // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3, term by term (c_pw / N^pw into the differences 1 to pw).
+        uint8_t sh = m;
+        for (uint8_t pw = 1; pw <= 3; ++pw, sh = static_cast<uint8_t>(sh + m)) {
+            for (uint8_t i = 1; i <= pw; ++i) {
+                add_q40(v[i], c[a][pw - 1], sh, i == 1 ? 1 : pw == 2 ? 2 : 6);
+            }
         }
-        prev_q8_[a] = p3[a];
+        prev_q8_[a] = g.p3[a];
     }
 }
 
@@ -326,7 +321,8 @@ bool CurveWalker::next_piece() {
     --pieces_;
     bool last = pieces_ == 0;
     // The end of the piece on the curve and 3 x its arms at both ends, ticks x 256.
-    int32_t p3[3], arm0[3], arm3[3];
+    Piece g;
+    int32_t *p3 = g.p3, *arm0 = g.arm0, *arm3 = g.arm3;
     // Helix: w moves linearly (arms of a third of its move), the last piece landing exactly on
     // the end.
     int32_t w3 = dw_q8_;
@@ -353,7 +349,7 @@ bool CurveWalker::next_piece() {
             p3[1] = pts_[1][3];
         }
     }
-    start_piece(p3, arm0, arm3);
+    start_piece(g);
     return true;
 }
 

@@ -112,7 +112,11 @@ class CurveWalker {
   private:
     void begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind);
     bool next_piece();
-    void start_piece(const int32_t p3[3], const int32_t arm0[3], const int32_t arm3[3]);
+    /// A piece: its end and 3 x its arms at both ends, ticks x 256 (u, v, w).
+    struct Piece {
+        int32_t p3[3], arm0[3], arm3[3];
+    };
+    void start_piece(const Piece& g);
     void arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const;
     void bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const;
 
