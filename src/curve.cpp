@@ -148,16 +148,68 @@ inline void fd_step(int64_t v[4]) {
 // acc += n x / 2^s in Q40 for x in Q8 (n x below 2^31, s <= 36): exact for s <= 32, floored
 // beyond.
 __attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s, uint8_t n) {
+#if defined(__AVR__)
+    // The addend in two words shifted together, then added byte by byte: avr-gcc would call the
+    // 64-bit shift and sum routines of its library, which nothing else in the image needs.
+    uint32_t hi = static_cast<uint32_t>(x * n), lo = 0;
+    uint8_t* p = reinterpret_cast<uint8_t*>(&acc);
+    asm volatile("tst  %[s]\n\t"
+                 "breq 2f\n"
+                 "1:\n\t"
+                 "asr  %D[hi]\n\t"
+                 "ror  %C[hi]\n\t"
+                 "ror  %B[hi]\n\t"
+                 "ror  %A[hi]\n\t"
+                 "ror  %D[lo]\n\t"
+                 "ror  %C[lo]\n\t"
+                 "ror  %B[lo]\n\t"
+                 "ror  %A[lo]\n\t"
+                 "dec  %[s]\n\t"
+                 "brne 1b\n"
+                 "2:\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "add  __tmp_reg__, %A[lo]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %B[lo]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %C[lo]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %D[lo]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %A[hi]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %B[hi]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %C[hi]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %D[hi]\n\t"
+                 "st   Z, __tmp_reg__"
+                 : [hi] "+r"(hi), [lo] "+r"(lo), [s] "+r"(s), "+z"(p)
+                 :
+                 : "memory");
+#else
     acc += (static_cast<int64_t>(x * n) << 32) >> s;
+#endif
 }
 
 // x + (y - x) a = (x (2^20 - a) + y a) / 2^20 (floored), a in [0, 1] as Q20: one step of de
-// Casteljau's algorithm, exact in 64 bits.
+// Casteljau's algorithm, exact (y - x fits in 32 bits: the points are within 2^30 of zero).
 __attribute__((noinline)) int32_t lerp(int32_t x, int32_t y, uint32_t a_q20) {
-    return static_cast<int32_t>(
-        (static_cast<int64_t>(x) * static_cast<int32_t>((1ul << 20) - a_q20) +
-         static_cast<int64_t>(y) * static_cast<int32_t>(a_q20)) >>
-        20);
+    return x +
+           static_cast<int32_t>((static_cast<int64_t>(y - x) * static_cast<int32_t>(a_q20)) >> 20);
+}
+
+// x + 2 pi (radians x 2^29), out of line: in a loop, avr-gcc would make the sum of the turns a
+// 64-bit product, a library routine that nothing else in the image needs.
+__attribute__((noinline)) int64_t add_turn(int64_t x) {
+    return x + kTurnQ29;
 }
 
 } // namespace
@@ -176,7 +228,7 @@ void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], i
 int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clockwise,
                       uint8_t turns) {
     int64_t sweep = sweep_q29(atan2_q29(s0, c0), atan2_q29(s1, c1), clockwise);
-    while (turns--) sweep += kTurnQ29;
+    while (turns--) sweep = add_turn(sweep);
     return clockwise ? -sweep : sweep;
 }
 
