@@ -308,7 +308,8 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees) and kMaxPieceTicks long (sweep x
     // radius ticks).
     uint32_t rmax = (a_.radii[0] > a_.radii[1] ? a_.radii[0] : a_.radii[1]) >> 8;
-    uint32_t n = static_cast<uint16_t>(mag >> 17) / 3u + 1u;
+    // (x / 3 for x = mag / 2^17 below 2^14, by its reciprocal: a division is a library call.)
+    uint32_t n = ((mag >> 17) * 21846ul >> 16) + 1u;
     uint32_t by_length = Num(mag, -20).mul(rmax + 1).div(kMaxPieceTicks).u32() + 1;
     if (by_length > n) n = by_length;
     if (n > 0xFFFF) return false;
