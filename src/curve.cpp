@@ -104,14 +104,25 @@ uint32_t sweep_q29(int32_t a0, int32_t a1, bool clockwise) {
     return a1 > a0 ? d : d + kTurnQ29;
 }
 
+// ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30.
+__attribute__((noinline)) void direction(const int32_t p[2], const int32_t centre[2],
+                                         const uint32_t radii[2], int32_t out[2]) {
+    Num q[2];
+    uint8_t neg = 0;
+    for (uint8_t k = 0; k < 2; ++k) {
+        const int32_t v = p[k] - centre[k];
+        q[k] = Num(mag(v)).div(radii[k]);
+        if (v < 0) neg = static_cast<uint8_t>(neg | (1u << k));
+    }
+    unit_vector(q, 2, neg, 30, out);
+}
+
 // Directions (cos t, sin t) of an arc's start and end seen from its centre in the ellipse's
 // scale (Q30), and its sweep without the extra turns (radians x 2^29).
 uint32_t arc_directions(const int32_t start[2], const int32_t end[2], const int32_t centre[2],
                         const uint32_t radii[2], bool clockwise, int32_t dir[2][2]) {
-    const int32_t* pt[2] = {start, end};
-    for (uint8_t i = 0; i < 2; ++i) {
-        ellipse_direction(pt[i][0] - centre[0], pt[i][1] - centre[1], radii, dir[i][0], dir[i][1]);
-    }
+    direction(start, centre, radii, dir[0]);
+    direction(end, centre, radii, dir[1]);
     // The signed sweep's low word (its magnitude is below 2^32).
     const uint32_t sweep = static_cast<uint32_t>(
         arc_sweep_q29(dir[0][0], dir[0][1], dir[1][0], dir[1][1], clockwise, 0));
@@ -216,11 +227,9 @@ __attribute__((noinline)) int64_t add_turn(int64_t x) {
 
 void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], int32_t& c,
                        int32_t& s) {
-    const int32_t v[2] = {x_q8, y_q8};
-    Num q[2];
-    for (uint8_t k = 0; k < 2; ++k) q[k] = Num(mag(v[k])).div(radii_q8[k]);
+    const int32_t p[2] = {x_q8, y_q8}, zero[2] = {0, 0};
     int32_t u[2];
-    unit_vector(q, 2, static_cast<uint8_t>((x_q8 < 0) | (y_q8 < 0) << 1), 30, u);
+    direction(p, zero, radii_q8, u);
     c = u[0];
     s = u[1];
 }
