@@ -104,16 +104,24 @@ uint32_t sweep_q29(int32_t a0, int32_t a1, bool clockwise) {
     return a1 > a0 ? d : d + kTurnQ29;
 }
 
+// q = (|v0|, |v1|, third); returns the signs of v0 and v1 (bits 0 and 1).
+__attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& third, Num q[3]) {
+    uint8_t neg = 0;
+    for (uint8_t i = 0; i < 2; ++i) {
+        q[i] = Num(mag(v[i]));
+        if (v[i] < 0) neg = static_cast<uint8_t>(neg | (1u << i));
+    }
+    q[2] = third;
+    return neg;
+}
+
 // ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30.
 __attribute__((noinline)) void direction(const int32_t p[2], const int32_t centre[2],
                                          const uint32_t radii[2], int32_t out[2]) {
-    Num q[2];
-    uint8_t neg = 0;
-    for (uint8_t k = 0; k < 2; ++k) {
-        const int32_t v = p[k] - centre[k];
-        q[k] = Num(mag(v)).div(radii[k]);
-        if (v < 0) neg = static_cast<uint8_t>(neg | (1u << k));
-    }
+    const int32_t v[2] = {p[0] - centre[0], p[1] - centre[1]};
+    Num q[3];
+    const uint8_t neg = components(v, Num{}, q);
+    for (uint8_t k = 0; k < 2; ++k) q[k].div(radii[k]);
     unit_vector(q, 2, neg, 30, out);
 }
 
@@ -544,8 +552,9 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
 }
 
 // |(x, y)| for signed x, y, or with `with_rise` |(x, y, rise)|.
-Num norm(const int32_t v[2], const Track& k, bool with_rise) {
-    const Num q[3] = {Num(mag(v[0])), Num(mag(v[1])), k.rise};
+__attribute__((noinline)) Num norm(const int32_t v[2], const Track& k, bool with_rise) {
+    Num q[3];
+    components(v, k.rise, q);
     return root_sum_squares(q, with_rise ? 3 : 2);
 }
 
@@ -559,8 +568,9 @@ void tangent(Track& k, int32_t out[3]) {
         const uint32_t in = kOneQ29 >> 12; // backwards from t = 1: modulo 2^32
         track_at(k, k.b.t ? static_cast<uint32_t>(0u - in) : in, false, d, d2);
     }
-    const Num q[3] = {Num(mag(d[0])), Num(mag(d[1])), k.rise};
-    unit_vector(q, 3, static_cast<uint8_t>((d[0] < 0) | (d[1] < 0) << 1 | k.w_down << 2), 29, out);
+    Num q[3];
+    const uint8_t neg = components(d, k.rise, q);
+    unit_vector(q, 3, static_cast<uint8_t>(neg | k.w_down << 2), 29, out);
 }
 
 // The track at `off` (Q29) past its current point, which with `move` becomes the current one:
