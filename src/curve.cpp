@@ -425,20 +425,18 @@ bool CurveWalker::next_piece() {
 
 bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
     moved = neg = 0;
-    while (left_ == 0) {
+    if (left_ == 0) { // (a piece has at least one sample)
         if (kind_ == 0) return false;
-        if (!next_piece()) {
-            // Last step: from the rounded end of the curve to the exact target (at most one
-            // tick per axis: both are within 0.71 tick of the curve's end point).
-            kind_ = 0;
-            break;
-        }
+        // Last step: from the rounded end of the curve to the exact target (at most one tick
+        // per axis: both are within 0.71 tick of the curve's end point).
+        if (!next_piece()) kind_ = 0;
     }
-    uint8_t bit = 1;
-    for (uint8_t a = 0; a < 3; ++a, bit = static_cast<uint8_t>(bit << 1)) {
+    const bool walking = kind_ != 0;
+    const uint8_t axes = walking ? axes_ : 3;
+    uint8_t bits = 0, down = 0, bit = 1;
+    for (uint8_t a = 0; a < axes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         int32_t p = end_[a];
-        if (kind_ != 0) {
-            if (a == axes_) break;
+        if (walking) {
             int64_t* v = fd_[a];
             fd_step(v);
             // round(f / 2^40) from the high word: floor((hi + 2^7) / 2^8). The word is read
@@ -448,18 +446,20 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
             p = base_[a] + ((hi + 128) >> 8);
         }
         if (p != pos[a]) {
-            moved = static_cast<uint8_t>(moved | bit);
-            if (p < pos[a]) neg = static_cast<uint8_t>(neg | bit);
+            bits = static_cast<uint8_t>(bits | bit);
+            if (p < pos[a]) down = static_cast<uint8_t>(down | bit);
             pos[a] = p;
         }
     }
-    if (kind_ == 0) return moved != 0;
+    moved = bits;
+    neg = down;
+    if (!walking) return bits != 0;
     --left_;
     return true;
 }
 
 uint16_t CurveWalker::peek(int32_t d[3]) {
-    while (left_ == 0 && kind_ != 0 && pieces_ != 0) next_piece();
+    if (left_ == 0 && kind_ != 0) next_piece(); // (a piece has at least one sample)
     // d1 / 2^24 (below 2^17): bits 24 to 55 of the little-endian word.
     for (uint8_t a = 0; a < 3; ++a) {
         memcpy(&d[a], reinterpret_cast<const uint8_t*>(&fd_[a][1]) + 3, 4);
