@@ -333,7 +333,7 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     piece_count_ = pieces_ = static_cast<uint16_t>(n);
     // Piece angle h, Q30 (at most 21.5 degrees, so the series apply), and 3 x the arm of its
     // cubic per unit of radius, 4 tan(h/4).
-    int32_t h = static_cast<int32_t>(Num(mag).div(n).shift(10).u32());
+    int32_t h = static_cast<int32_t>(div_frac(mag, n, 10));
     if (clockwise) h = -h;
     rotation(h, a_.rot);
     int32_t x = h >> 2;
