@@ -344,10 +344,11 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     return true;
 }
 
-void CurveWalker::bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const {
-    // B(a) (with `point`) and B'(a) / 2^j, 3 x the arm of the piece that starts or ends there
-    // (ticks x 256), by de Casteljau's algorithm: every value stays within the control points'
-    // hull.
+void CurveWalker::bezier_at(uint16_t at, int32_t point[2], int32_t arm[2]) const {
+    // At a = at / 2^j (Q20): B(a) (with `point`) and B'(a) / 2^j, 3 x the arm of the piece that
+    // starts or ends there (ticks x 256), by de Casteljau's algorithm: every value stays within
+    // the control points' hull.
+    const uint32_t a_q20 = static_cast<uint32_t>(at) << (20 - log_pieces_);
     for (uint8_t k = 0; k < 2; ++k) {
         int32_t q[4];
         memcpy(q, pts_[k], sizeof(q));
@@ -411,9 +412,8 @@ bool CurveWalker::next_piece() {
         arc_at(dir, p3, arm3);
     } else {
         // Bezier part [a, a + 1/n]: the curve's ends and tangents.
-        uint32_t a0 = static_cast<uint32_t>(index) << (20 - log_pieces_);
-        bezier_at(a0, nullptr, arm0); // (the start is the last piece's end)
-        bezier_at(a0 + (1ul << (20 - log_pieces_)), p3, arm3);
+        bezier_at(index, nullptr, arm0); // (the start is the last piece's end)
+        bezier_at(static_cast<uint16_t>(index + 1), p3, arm3);
         if (last) { // the commanded end
             p3[0] = pts_[0][3];
             p3[1] = pts_[1][3];

@@ -118,7 +118,7 @@ class CurveWalker {
     };
     void start_piece(const Piece& g);
     void arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const;
-    void bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const;
+    void bezier_at(uint16_t at, int32_t point[2], int32_t arm[2]) const;
 
     // The small fields first, the forward differences last: on the ATmega328P a field within 63
     // bytes of the object is reached by displacement, one beyond costs a pointer computation.
