@@ -106,13 +106,10 @@ uint32_t sweep_q29(int32_t a0, int32_t a1, bool clockwise) {
 
 // q = (|v0|, |v1|, third); returns the signs of v0 and v1 (bits 0 and 1).
 __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& third, Num q[3]) {
-    uint8_t neg = 0;
-    for (uint8_t i = 0; i < 2; ++i) {
-        q[i] = Num(mag(v[i]));
-        if (v[i] < 0) neg = static_cast<uint8_t>(neg | (1u << i));
-    }
     q[2] = third;
-    return neg;
+    q[1].set(mag(v[1]));
+    q[0].set(mag(v[0]));
+    return static_cast<uint8_t>((v[0] < 0) | (v[1] < 0) << 1);
 }
 
 // ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30.
@@ -634,7 +631,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     bool circle = false;
     Num len{};
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
-    k.rise = Num(mag(dw_um));
+    k.rise.set(mag(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
         if (r[0] == 0 || r[1] == 0) return false;
@@ -643,7 +640,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         span = arc_directions(cp.start_um, cp.end_um, cp.a_um, r, k.clockwise, k.e.dir);
         widest = kWidestArcQ29;
         turns = cp.turns;
-        len = Num(kTurnQ29, -29).mul(turns).add(Num(span, -29));
+        len.set(kTurnQ29, -29).mul(turns).add(Num(span, -29));
         // w rises linearly with the angle: dw / |sweep| per radian.
         const Num dw = k.rise;
         k.rise.div(len);
