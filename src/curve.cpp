@@ -629,9 +629,12 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     uint32_t span = kOneQ29, widest = kWidestBezierQ29;
     uint8_t turns = 0;
     bool circle = false;
-    Num len{};
+    // The length, and |dw| (a circular helix' length is their root sum of squares).
+    Num ld[2];
+    Num& len = ld[0];
+    len.set(0);
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
-    k.rise.set(mag(dw_um));
+    k.rise = ld[1].set(mag(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
         if (r[0] == 0 || r[1] == 0) return false;
@@ -642,7 +645,6 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         turns = cp.turns;
         len.set(kTurnQ29, -29).mul(turns).add(Num(span, -29));
         // w rises linearly with the angle: dw / |sweep| per radian.
-        const Num dw = k.rise;
         k.rise.div(len);
         memcpy(k.e.r, r, sizeof(k.e.r));
         scale = normalise(k.e.r, 2);
@@ -651,10 +653,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
         circle = lo == hi;
         len.mul(lo); // a circle: r |sweep|, and a helix: sqrt(plane^2 + dw^2)
-        if (w_regulated) {
-            const Num q[2] = {len, dw};
-            len = root_sum_squares(q, 2);
-        }
+        if (w_regulated) len = root_sum_squares(ld, 2);
     } else {
         // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
