@@ -493,7 +493,7 @@ struct Track {
         } b;                 ///< Bezier
     };
     Num rise; ///< |dw / dparameter|: the helix' rise
-    Num rmin; ///< Bezier: smallest radius of curvature met so far (0: none)
+    Num rmin; ///< Bezier: smallest radius of curvature met so far (at first 2^100: none)
 };
 
 // Shifts v[0..n-1] left or right so that the largest magnitude is in [2^27, 2^28); the shift.
@@ -585,7 +585,7 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
         if (cross != 0) {
             Num rc = n1;
             rc.mul(n1).mul(n1).div(mag(cross)).shift(-30);
-            if (k.rmin.m == 0 || rc.cmp(k.rmin) < 0) k.rmin = rc;
+            if (rc.cmp(k.rmin) < 0) k.rmin = rc;
         }
     }
     if (half) {
@@ -678,8 +678,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         len.div(18).shift(static_cast<int8_t>(-29 - scale));
     }
     if (k.bezier) {
-        out.min_radius_um =
-            k.rmin.m ? k.rmin.shift(static_cast<int8_t>(-scale)).u32() : 0xFFFFFFFFul;
+        out.min_radius_um = k.rmin.shift(static_cast<int8_t>(-scale)).u32(); // none: saturates
     } else {
         memcpy(k.e.dir[0], k.e.dir[1], sizeof(k.e.dir[0]));
     }
@@ -693,6 +692,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
 
 bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
     Track k{};
+    k.rmin.set(1, 100); // above any radius, and within range after the scale
     memset(out.start_dir, 0, sizeof(out.start_dir));
     memset(out.end_dir, 0, sizeof(out.end_dir));
     return shape(cp, dw_um, w_regulated && dw_um != 0, out, k);
