@@ -282,10 +282,8 @@ void CurveWalker::start_piece(const Piece& g) {
     for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
     for (uint8_t a = 0; a < 3; ++a) {
         int64_t* v = fd_[a];
-        base_[a] = prev_q8_[a] >> 8;
-        // f: the fraction of a tick where the piece starts, in the high word.
-        const int32_t frac = prev_q8_[a] & 0xFF;
-        memcpy(reinterpret_cast<uint8_t*>(v) + 4, &frac, 4);
+        // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
+        memcpy(reinterpret_cast<uint8_t*>(v) + 4, &prev_q8_[a], 4);
         // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
         // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3, term by term (c_pw / N^pw into the differences 1 to pw).
         uint8_t sh = m;
@@ -440,7 +438,7 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
             // from memory: avr-gcc would shift the 64 bits through a library loop.
             int32_t hi;
             memcpy(&hi, reinterpret_cast<const uint8_t*>(v) + 4, 4);
-            p = base_[a] + ((hi + 128) >> 8);
+            p = (hi + 128) >> 8;
         }
         if (p != pos[a]) {
             bits = static_cast<uint8_t>(bits | bit);

@@ -6,9 +6,9 @@
 // values, with N larger than the piece's largest axis speed (its hodograph bound), so that two
 // consecutive samples are at most one tick apart on every axis: the visited positions are the
 // samples rounded to the nearest tick, strictly successive, within 0.71 tick of the piece.
-// Samples are produced by forward differencing in 64-bit fixed point (Q40 ticks, relative to
-// the piece start): three additions per axis and per sample, no multiplication, no square root,
-// and since N is a power of two the differences are set up with shifts.
+// Samples are produced by forward differencing in 64-bit fixed point (Q40 ticks): three
+// additions per axis and per sample, no multiplication, no square root, and since N is a power
+// of two the differences are set up with shifts.
 //
 // Arcs and ellipses (X = cu + ru cos t, Y = cv + rv sin t, docs/curves.md): pieces of at most
 // 21.5 degrees (and 2000 ticks), each the cubic whose arms are 4/3 tan(h/4) long, which stays
@@ -132,7 +132,6 @@ class CurveWalker {
     int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
     int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
     int32_t end_[3];        ///< final position, ticks
-    int32_t base_[3];       ///< the current piece's start, ticks (fd_ is relative to it)
     // An arc or a Bezier, never both.
     struct ArcState {
         int32_t centre[2];
@@ -146,7 +145,7 @@ class CurveWalker {
         int32_t pts_[2][4]; ///< Bezier: control points, u then v, ticks x 256
     };
     // Current piece, per axis: the position and its forward differences (f, d1, d2, d3), Q40
-    // ticks relative to base_.
+    // ticks.
     int64_t fd_[3][4];
 };
 
