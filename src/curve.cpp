@@ -505,16 +505,9 @@ struct Track {
 int8_t normalise(int32_t* v, uint8_t n) {
     uint32_t big = 0;
     for (uint8_t i = 0; i < n; ++i) big |= mag(v[i]); // the largest's top bit
-    int8_t sh = 0;
     if (big == 0) return 0;
-    while (big >= (1ul << 28)) {
-        big >>= 1;
-        --sh;
-    }
-    while (big < (1ul << 27)) {
-        big <<= 1;
-        ++sh;
-    }
+    // big = m 2^e with m in [2^31, 2^32): its top bit is 31 + e, to be moved to bit 27.
+    const int8_t sh = static_cast<int8_t>(-4 - Num(big).e);
     for (uint8_t i = 0; i < n; ++i) {
         v[i] = sh < 0 ? v[i] >> -sh : static_cast<int32_t>(static_cast<uint32_t>(v[i]) << sh);
     }
