@@ -415,11 +415,9 @@ bool CurveWalker::next_piece() {
     } else {
         // Bezier part [a, a + 1/n]: the curve's ends and tangents.
         bezier_at(index, nullptr, arm0); // (the start is the last piece's end)
+        // (At a = 1 every step of de Casteljau's algorithm gives its right point exactly: the
+        // last piece ends on the commanded end.)
         bezier_at(static_cast<uint16_t>(index + 1), p3, arm3);
-        if (last) { // the commanded end
-            p3[0] = pts_[0][3];
-            p3[1] = pts_[1][3];
-        }
     }
     start_piece(g);
     return true;
