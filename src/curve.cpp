@@ -357,7 +357,7 @@ void CurveWalker::bezier_at(uint16_t at, int32_t point[2], int32_t arm[2]) const
         for (uint8_t n = 3; n > 1; --n) {
             for (uint8_t i = 0; i < n; ++i) q[i] = lerp(q[i], q[i + 1], a_q20);
         }
-        if (point) point[k] = lerp(q[0], q[1], a_q20);
+        point[k] = lerp(q[0], q[1], a_q20);
         // B'(a) = 3 (q1 - q0), with q1 - q0 below 2^31 in magnitude (as the points' differences).
         int32_t d = static_cast<int32_t>(static_cast<uint32_t>(q[1]) - static_cast<uint32_t>(q[0]));
         arm[k] = static_cast<int32_t>((static_cast<int64_t>(d) * 3) >> log_pieces_);
@@ -414,7 +414,7 @@ bool CurveWalker::next_piece() {
         arc_at(dir, p3, arm3);
     } else {
         // Bezier part [a, a + 1/n]: the curve's ends and tangents.
-        bezier_at(index, nullptr, arm0); // (the start is the last piece's end)
+        bezier_at(index, p3, arm0); // (its point, the last piece's end, is overwritten)
         // (At a = 1 every step of de Casteljau's algorithm gives its right point exactly: the
         // last piece ends on the commanded end.)
         bezier_at(static_cast<uint16_t>(index + 1), p3, arm3);
