@@ -627,8 +627,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     bool circle = false;
     // The length, and |dw| (a circular helix' length is their root sum of squares).
     Num ld[2];
-    Num& len = ld[0];
-    len.set(0);
+    Num& len = ld[0]; // (set below: an arc's in closed form, or by quadrature)
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
     k.rise = ld[1].set(mag(dw_um));
     if (cp.kind == kCurveArc) {
