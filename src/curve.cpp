@@ -662,6 +662,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         }
         scale = normalise(&k.b.h[0][0], 6);
         k.bezier = true;
+        k.rmin.set(1, 100); // above any radius, and within range after the scale
     }
     k.rise.shift(scale);
     k.w_counts = w_regulated;
@@ -686,10 +687,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
 } // namespace
 
 bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
-    Track k{};
-    k.rmin.set(1, 100); // above any radius, and within range after the scale
-    memset(out.start_dir, 0, sizeof(out.start_dir));
-    memset(out.end_dir, 0, sizeof(out.end_dir));
+    Track k{}; // (out's tangents are written in full: unit_vector() gives 0 for a null vector)
     return shape(cp, dw_um, w_regulated && dw_um != 0, out, k);
 }
 
