@@ -21,9 +21,14 @@ constexpr uint32_t kTurnQ29 = 2ul * kPiQ29;
 // 0.02 tick.
 constexpr uint32_t kMaxPieceTicks = 2000;
 
+// floor(a b / 2^s), the result within 32 bits.
+__attribute__((noinline)) int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
+    return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> s);
+}
+
 // (a b) >> 30: products of Q30 factors, and Q8 coordinates times Q30 factors.
 __attribute__((noinline)) int32_t mul_q30(int32_t a, int32_t b) {
-    return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> 30);
+    return mul_shift(a, b, 30);
 }
 
 // abs32 out of line: inline, each of its many uses costs 18 bytes on the AVR.
@@ -225,8 +230,7 @@ __attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s, uint8
 // x + (y - x) a = (x (2^20 - a) + y a) / 2^20 (floored), a in [0, 1] as Q20: one step of de
 // Casteljau's algorithm, exact (y - x fits in 32 bits: the points are within 2^30 of zero).
 __attribute__((noinline)) int32_t lerp(int32_t x, int32_t y, uint32_t a_q20) {
-    return x +
-           static_cast<int32_t>((static_cast<int64_t>(y - x) * static_cast<int32_t>(a_q20)) >> 20);
+    return x + mul_shift(y - x, static_cast<int32_t>(a_q20), 20);
 }
 
 // x + 2 pi (radians x 2^29), out of line: in a loop, avr-gcc would make the sum of the turns a
@@ -360,7 +364,7 @@ void CurveWalker::bezier_at(uint16_t at, int32_t point[2], int32_t arm[2]) const
         point[k] = lerp(q[0], q[1], a_q20);
         // B'(a) = 3 (q1 - q0), with q1 - q0 below 2^31 in magnitude (as the points' differences).
         int32_t d = static_cast<int32_t>(static_cast<uint32_t>(q[1]) - static_cast<uint32_t>(q[0]));
-        arm[k] = static_cast<int32_t>((static_cast<int64_t>(d) * 3) >> log_pieces_);
+        arm[k] = mul_shift(d, 3, log_pieces_);
     }
 }
 
