@@ -9,7 +9,11 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the walker reads the h
 
 // Size on the ATmega328P: every 64-bit addition, shift or product is a library call wrapped in
 // long register moves, and every Num operation a call sequence. So these operations are written
-// once, in the out-of-line helpers below, and the axes are loops, not copies.
+// once, in the out-of-line helpers below (the sample step and the 64-bit sums of add_q40 in
+// assembly, the only 64-bit library routines left a signed product and a shift), the axes are
+// loops, arrays are copied with memcpy (a byte loop, where four-byte moves are unrolled), and the
+// walker's small fields come first (a field within 63 bytes of the object is reached by
+// displacement).
 
 namespace ll {
 namespace {
@@ -32,7 +36,7 @@ __attribute__((noinline)) int32_t mul_q30(int32_t a, int32_t b) {
 }
 
 // abs32 out of line: inline, each of its many uses costs 18 bytes on the AVR.
-__attribute__((noinline)) uint32_t mag(int32_t v) {
+__attribute__((noinline)) uint32_t uabs(int32_t v) {
     return abs32(v);
 }
 
@@ -112,8 +116,8 @@ uint32_t sweep_q29(int32_t a0, int32_t a1, bool clockwise) {
 // q = (|v0|, |v1|, third); returns the signs of v0 and v1 (bits 0 and 1).
 __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& third, Num q[3]) {
     q[2] = third;
-    q[1].set(mag(v[1]));
-    q[0].set(mag(v[0]));
+    q[1].set(uabs(v[1]));
+    q[0].set(uabs(v[0]));
     return static_cast<uint8_t>((v[0] < 0) | (v[1] < 0) << 1);
 }
 
@@ -377,7 +381,7 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
         int32_t d[4];
         for (uint8_t i = 0; i < 4; ++i) d[i] = (pts_[k][i] = src[i][k]) >> 8;
         differences(d);
-        uint32_t b = 3 * (mag(d[1]) + 2 * mag(d[2]) + mag(d[3]));
+        uint32_t b = 3 * (uabs(d[1]) + 2 * uabs(d[2]) + uabs(d[3]));
         if (b > bound) bound = b;
     }
     // 2^j pieces, each with a hodograph bound below kMaxPieceTicks (it shrinks with 2^j).
@@ -506,7 +510,7 @@ struct Track {
 // Shifts v[0..n-1] left or right so that the largest magnitude is in [2^27, 2^28); the shift.
 int8_t normalise(int32_t* v, uint8_t n) {
     uint32_t big = 0;
-    for (uint8_t i = 0; i < n; ++i) big |= mag(v[i]); // the largest's top bit
+    for (uint8_t i = 0; i < n; ++i) big |= uabs(v[i]); // the largest's top bit
     if (big == 0) return 0;
     // big = m 2^e with m in [2^31, 2^32): its top bit is 31 + e, to be moved to bit 27.
     const int8_t sh = static_cast<int8_t>(-4 - Num(big).e);
@@ -584,7 +588,7 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
         int32_t cross = mul_q30(d1[0], d2[1]) - mul_q30(d1[1], d2[0]);
         if (cross != 0) {
             Num rc = n1;
-            rc.mul(n1).mul(n1).div(mag(cross)).shift(-30);
+            rc.mul(n1).mul(n1).div(uabs(cross)).shift(-30);
             if (rc.cmp(k.rmin) < 0) k.rmin = rc;
         }
     }
@@ -633,7 +637,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     Num ld[2];
     Num& len = ld[0]; // (set below: an arc's in closed form, or by quadrature)
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
-    k.rise = ld[1].set(mag(dw_um));
+    k.rise = ld[1].set(uabs(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
         if (r[0] == 0 || r[1] == 0) return false;
