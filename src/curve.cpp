@@ -606,10 +606,12 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
 // end, and these crowd where the curve turns tightly.
 Num track_length(Track& k, uint32_t span, uint32_t widest) {
     Num total{};
-    uint32_t half;
-    probe(k, 0, false, &half);
-    while (span != 0) {
-        uint32_t w = half; // in a register: half's address is taken
+    uint32_t half, w = 0;
+    for (;;) {
+        probe(k, w, true, &half); // the end of the last panel (at first, the start: w = 0)
+        span -= w;
+        if (span == 0) break;
+        w = half; // in a register: half's address is taken
         if (w > widest) w = widest;
         if (w < kNarrowestQ29) w = kNarrowestQ29;
         if (w > span) w = span;
@@ -618,8 +620,6 @@ Num track_length(Track& k, uint32_t span, uint32_t widest) {
         Num sum = probe(k, g, false, nullptr);
         sum.add(probe(k, w - g, false, nullptr)).mul(5).add(probe(k, w / 2, false, nullptr).mul(8));
         total.add(sum.mul(w));
-        span -= w;
-        probe(k, w, true, &half);
     }
     return total;
 }
