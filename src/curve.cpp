@@ -9,7 +9,11 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the walker reads the h
 
 // Size on the ATmega328P: every 64-bit addition, shift or product is a library call wrapped in
 // long register moves, and every Num operation a call sequence. So these operations are written
-// once, in the out-of-line helpers below, and the axes are loops, not copies.
+// once, in the out-of-line helpers below (the sample step and the 64-bit sums of add_q40 in
+// assembly, the only 64-bit library routines left a signed product and a shift), the axes are
+// loops, arrays are copied with memcpy (a byte loop, where four-byte moves are unrolled), and the
+// walker's small fields come first (a field within 63 bytes of the object is reached by
+// displacement).
 
 namespace ll {
 namespace {
@@ -21,9 +25,19 @@ constexpr uint32_t kTurnQ29 = 2ul * kPiQ29;
 // 0.02 tick.
 constexpr uint32_t kMaxPieceTicks = 2000;
 
+// floor(a b / 2^s), the result within 32 bits.
+__attribute__((noinline)) int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
+    return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> s);
+}
+
 // (a b) >> 30: products of Q30 factors, and Q8 coordinates times Q30 factors.
 __attribute__((noinline)) int32_t mul_q30(int32_t a, int32_t b) {
-    return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> 30);
+    return mul_shift(a, b, 30);
+}
+
+// abs32 out of line: inline, each of its many uses costs 18 bytes on the AVR.
+__attribute__((noinline)) uint32_t uabs(int32_t v) {
+    return abs32(v);
 }
 
 // Forward differences in place: (p0, p1, p2, p3) -> (p0, p1 - p0, p2 - 2 p1 + p0, p3 - 3 p2 + ...).
@@ -64,18 +78,26 @@ void rotate(int32_t v[2], const int32_t rot[2]) {
     v[0] = c;
 }
 
-// sqrt(a^2 + b^2 + cc).
-Num hypot(Num a, Num b, const Num& cc) {
-    a.mul(a);
-    b.mul(b);
-    return a.add(b).add(cc).sqrt();
+// sqrt(q0^2 + ... + q(n-1)^2).
+__attribute__((noinline)) Num root_sum_squares(const Num* q, uint8_t n) {
+    Num sum{};
+    for (uint8_t i = 0; i < n; ++i) {
+        Num t = q[i];
+        sum.add(t.mul(q[i]));
+    }
+    return sum.sqrt();
 }
 
-// num / den as a signed fixed-point value with `bits` fraction bits, at most 1 in magnitude.
-__attribute__((noinline)) int32_t unit_part(Num num, const Num& den, bool negative, uint8_t bits) {
-    uint32_t u = num.div(den).shift(static_cast<int8_t>(bits)).u32();
-    if (u > (1ul << bits)) u = 1ul << bits;
-    return negative ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+// out[i] = q[i] / |q| for the n components of q, `bits` fraction bits, negated where bit i of
+// `neg` is set; 0 for q = 0 (a quotient by zero is zero).
+__attribute__((noinline)) void unit_vector(const Num* q, uint8_t n, uint8_t neg, uint8_t bits,
+                                           int32_t* out) {
+    const Num norm = root_sum_squares(q, n);
+    for (uint8_t i = 0; i < n; ++i) {
+        uint32_t u = Num(q[i]).div(norm).shift(static_cast<int8_t>(bits)).u32();
+        if (u > (1ul << bits)) u = 1ul << bits;
+        out[i] = (neg >> i) & 1 ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+    }
 }
 
 // |sweep| in (0, 2 pi] from the angle a0 to the angle a1 (radians x 2^29, in (-pi, pi]),
@@ -91,75 +113,167 @@ uint32_t sweep_q29(int32_t a0, int32_t a1, bool clockwise) {
     return a1 > a0 ? d : d + kTurnQ29;
 }
 
+// q = (|v0|, |v1|, third); returns the signs of v0 and v1 (bits 0 and 1).
+__attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& third, Num q[3]) {
+    q[2] = third;
+    q[1].set(uabs(v[1]));
+    q[0].set(uabs(v[0]));
+    return static_cast<uint8_t>((v[0] < 0) | (v[1] < 0) << 1);
+}
+
+// ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30.
+__attribute__((noinline)) void direction(const int32_t p[2], const int32_t centre[2],
+                                         const uint32_t radii[2], int32_t out[2]) {
+    const int32_t v[2] = {p[0] - centre[0], p[1] - centre[1]};
+    Num q[3];
+    const uint8_t neg = components(v, Num{}, q);
+    for (uint8_t k = 0; k < 2; ++k) q[k].div(radii[k]);
+    unit_vector(q, 2, neg, 30, out);
+}
+
 // Directions (cos t, sin t) of an arc's start and end seen from its centre in the ellipse's
 // scale (Q30), and its sweep without the extra turns (radians x 2^29).
 uint32_t arc_directions(const int32_t start[2], const int32_t end[2], const int32_t centre[2],
                         const uint32_t radii[2], bool clockwise, int32_t dir[2][2]) {
-    const int32_t* pt[2] = {start, end};
-    int32_t a[2];
-    for (uint8_t i = 0; i < 2; ++i) {
-        ellipse_direction(pt[i][0] - centre[0], pt[i][1] - centre[1], radii, dir[i][0], dir[i][1]);
-        a[i] = atan2_q29(dir[i][1], dir[i][0]);
-    }
-    return sweep_q29(a[0], a[1], clockwise);
+    direction(start, centre, radii, dir[0]);
+    direction(end, centre, radii, dir[1]);
+    // The signed sweep's low word (its magnitude is below 2^32).
+    const uint32_t sweep = static_cast<uint32_t>(
+        arc_sweep_q29(dir[0][0], dir[0][1], dir[1][0], dir[1][1], clockwise, 0));
+    return clockwise ? 0u - sweep : sweep;
 }
 
 // One sample of a cubic by forward differencing: f += d1, d1 += d2, d2 += d3 (v = f, d1, d2, d3).
 inline void fd_step(int64_t v[4]) {
+#if defined(__AVR__)
+    // Byte by byte in place, each sum with the next value's old bytes (8 bytes on), two bytes a
+    // turn: about 215 cycles and 36 bytes, where avr-gcc calls __adddi3 three times through long
+    // register moves.
+    uint8_t n, k, x, y;
+    asm volatile("ldi  %[n], 3\n"
+                 "1:\n\t"
+                 "ldi  %[k], 4\n\t"
+                 "clc\n"
+                 "2:\n\t"
+                 "ld   %[x], Z\n\t"
+                 "ldd  %[y], Z+8\n\t"
+                 "adc  %[x], %[y]\n\t"
+                 "st   Z+, %[x]\n\t"
+                 "ld   %[x], Z\n\t"
+                 "ldd  %[y], Z+8\n\t"
+                 "adc  %[x], %[y]\n\t"
+                 "st   Z+, %[x]\n\t"
+                 "dec  %[k]\n\t"
+                 "brne 2b\n\t"
+                 "dec  %[n]\n\t"
+                 "brne 1b"
+                 : "+z"(v), [n] "=&d"(n), [k] "=&d"(k), [x] "=&r"(x), [y] "=&r"(y)
+                 :
+                 : "memory");
+#else
     v[0] += v[1];
     v[1] += v[2];
     v[2] += v[3];
+#endif
 }
 
 // acc += n x / 2^s in Q40 for x in Q8 (n x below 2^31, s <= 36): exact for s <= 32, floored
 // beyond.
 __attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s, uint8_t n) {
+#if defined(__AVR__)
+    // The addend in two words shifted together, then added byte by byte: avr-gcc would call the
+    // 64-bit shift and sum routines of its library, which nothing else in the image needs.
+    uint32_t hi = static_cast<uint32_t>(x * n), lo = 0;
+    uint8_t* p = reinterpret_cast<uint8_t*>(&acc);
+    asm volatile("tst  %[s]\n\t"
+                 "breq 2f\n"
+                 "1:\n\t"
+                 "asr  %D[hi]\n\t"
+                 "ror  %C[hi]\n\t"
+                 "ror  %B[hi]\n\t"
+                 "ror  %A[hi]\n\t"
+                 "ror  %D[lo]\n\t"
+                 "ror  %C[lo]\n\t"
+                 "ror  %B[lo]\n\t"
+                 "ror  %A[lo]\n\t"
+                 "dec  %[s]\n\t"
+                 "brne 1b\n"
+                 "2:\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "add  __tmp_reg__, %A[lo]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %B[lo]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %C[lo]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %D[lo]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %A[hi]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %B[hi]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %C[hi]\n\t"
+                 "st   Z+, __tmp_reg__\n\t"
+                 "ld   __tmp_reg__, Z\n\t"
+                 "adc  __tmp_reg__, %D[hi]\n\t"
+                 "st   Z, __tmp_reg__"
+                 : [hi] "+r"(hi), [lo] "+r"(lo), [s] "+r"(s), "+z"(p)
+                 :
+                 : "memory");
+#else
     acc += (static_cast<int64_t>(x * n) << 32) >> s;
+#endif
 }
 
 // x + (y - x) a = (x (2^20 - a) + y a) / 2^20 (floored), a in [0, 1] as Q20: one step of de
-// Casteljau's algorithm, exact in 64 bits.
+// Casteljau's algorithm, exact (y - x fits in 32 bits: the points are within 2^30 of zero).
 __attribute__((noinline)) int32_t lerp(int32_t x, int32_t y, uint32_t a_q20) {
-    return static_cast<int32_t>(
-        (static_cast<int64_t>(x) * static_cast<int32_t>((1ul << 20) - a_q20) +
-         static_cast<int64_t>(y) * static_cast<int32_t>(a_q20)) >>
-        20);
+    return x + mul_shift(y - x, static_cast<int32_t>(a_q20), 20);
+}
+
+// x + 2 pi (radians x 2^29), out of line: in a loop, avr-gcc would make the sum of the turns a
+// 64-bit product, a library routine that nothing else in the image needs.
+__attribute__((noinline)) int64_t add_turn(int64_t x) {
+    return x + kTurnQ29;
 }
 
 } // namespace
 
 void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], int32_t& c,
                        int32_t& s) {
-    const int32_t v[2] = {x_q8, y_q8};
-    Num q[2];
-    for (uint8_t k = 0; k < 2; ++k) q[k] = Num(abs32(v[k])).div(radii_q8[k]);
-    Num n = hypot(q[0], q[1], Num{});
-    c = unit_part(q[0], n, x_q8 < 0, 30);
-    s = unit_part(q[1], n, y_q8 < 0, 30);
+    const int32_t p[2] = {x_q8, y_q8}, zero[2] = {0, 0};
+    int32_t u[2];
+    direction(p, zero, radii_q8, u);
+    c = u[0];
+    s = u[1];
 }
 
 int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clockwise,
                       uint8_t turns) {
     int64_t sweep = sweep_q29(atan2_q29(s0, c0), atan2_q29(s1, c1), clockwise);
-    while (turns--) sweep += kTurnQ29;
+    while (turns--) sweep = add_turn(sweep);
     return clockwise ? -sweep : sweep;
 }
 
 void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
-    for (uint8_t a = 0; a < 3; ++a) {
-        pos[a] = e.start[a];
-        end_[a] = e.end[a];
-        prev_q8_[a] = a < 2 ? p0_q8[a] : e.start[2] * 256;
-    }
+    memcpy(pos, e.start, sizeof(pos));
+    memcpy(end_, e.end, sizeof(end_));
+    memcpy(prev_q8_, p0_q8, 2 * sizeof(prev_q8_[0]));
     // w moves linearly along the curve (a helix); without it, only u and v are walked.
-    w0_q8_ = prev_q8_[2];
+    prev_q8_[2] = w0_q8_ = e.start[2] * 256;
     dw_q8_ = e.end[2] * 256 - w0_q8_;
     axes_ = dw_q8_ ? 3 : 2;
     kind_ = kind;
     left_ = 0;
 }
 
-void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const int32_t arm3[3]) {
+void CurveWalker::start_piece(const Piece& g) {
     // The cubic from prev_q8_ (p0) to p3 whose control points are p0 + arm0 / 3 and
     // p3 - arm3 / 3, ticks x 256: relative to p0, c1 t + c2 t^2 + c3 t^3 with c1 = arm0,
     // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0.
@@ -167,9 +281,9 @@ void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const 
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
     for (uint8_t a = 0; a < 3; ++a) {
         int32_t* k = c[a];
-        const int32_t d = p3[a] - prev_q8_[a];
-        k[0] = arm0[a];
-        k[2] = arm0[a] + arm3[a] - 2 * d;
+        const int32_t d = g.p3[a] - prev_q8_[a];
+        k[0] = g.arm0[a];
+        k[2] = g.arm0[a] + g.arm3[a] - 2 * d;
         k[1] = d - k[0] - k[2];
         const uint32_t a2 = abs32(k[2]);
         const uint32_t b = abs32(k[0]) + 2 * (abs32(k[1]) + a2) + a2;
@@ -177,25 +291,23 @@ void CurveWalker::start_piece(const int32_t p3[3], const int32_t arm0[3], const 
     }
     // N = 2^m > bound (ticks): at most one tick per sample and axis.
     uint8_t m = 0;
-    while ((1ul << (m + 8)) <= bound) ++m;
+    for (uint32_t b = bound >> 8; b != 0; b >>= 1) ++m;
     left_ = static_cast<uint16_t>(1u << m);
     uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
     for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
-    const uint8_t m2 = static_cast<uint8_t>(2 * m), m3 = static_cast<uint8_t>(3 * m);
     for (uint8_t a = 0; a < 3; ++a) {
         int64_t* v = fd_[a];
-        const int32_t* k = c[a];
-        base_[a] = prev_q8_[a] >> 8;
+        // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
+        memcpy(reinterpret_cast<uint8_t*>(v) + 4, &prev_q8_[a], 4);
         // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
-        // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3.
-        add_q40(v[0], prev_q8_[a] & 0xFF, 0, 1);
-        add_q40(v[1], k[0], m, 1);
-        add_q40(v[1], k[1], m2, 1);
-        add_q40(v[1], k[2], m3, 1);
-        add_q40(v[2], k[1], m2, 2);
-        add_q40(v[2], k[2], m3, 6);
-        add_q40(v[3], k[2], m3, 6);
-        prev_q8_[a] = p3[a];
+        // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3, term by term (c_pw / N^pw into the differences 1 to pw).
+        uint8_t sh = m;
+        for (uint8_t pw = 1; pw <= 3; ++pw, sh = static_cast<uint8_t>(sh + m)) {
+            for (uint8_t i = 1; i <= pw; ++i) {
+                add_q40(v[i], c[a][pw - 1], sh, i == 1 ? 1 : pw == 2 ? 2 : 6);
+            }
+        }
+        prev_q8_[a] = g.p3[a];
     }
 }
 
@@ -213,10 +325,8 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
                       bool clockwise, uint8_t turns) {
     kind_ = 0;
     if (radii_q8[0] == 0 || radii_q8[1] == 0) return false;
-    for (uint8_t k = 0; k < 2; ++k) {
-        a_.centre[k] = centre_q8[k];
-        a_.radii[k] = radii_q8[k];
-    }
+    memcpy(a_.centre, centre_q8, sizeof(a_.centre));
+    memcpy(a_.radii, radii_q8, sizeof(a_.radii));
     // Directions of the start and end points (their projections on the curve), and the sweep
     // with the extra turns, radians x 2^20 (below 2^31 for 255 turns).
     uint32_t mag =
@@ -225,14 +335,15 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees) and kMaxPieceTicks long (sweep x
     // radius ticks).
     uint32_t rmax = (a_.radii[0] > a_.radii[1] ? a_.radii[0] : a_.radii[1]) >> 8;
-    uint32_t n = static_cast<uint16_t>(mag >> 17) / 3u + 1u;
+    // (x / 3 for x = mag / 2^17 below 2^14, by its reciprocal: a division is a library call.)
+    uint32_t n = ((mag >> 17) * 21846ul >> 16) + 1u;
     uint32_t by_length = Num(mag, -20).mul(rmax + 1).div(kMaxPieceTicks).u32() + 1;
     if (by_length > n) n = by_length;
     if (n > 0xFFFF) return false;
     piece_count_ = pieces_ = static_cast<uint16_t>(n);
     // Piece angle h, Q30 (at most 21.5 degrees, so the series apply), and 3 x the arm of its
     // cubic per unit of radius, 4 tan(h/4).
-    int32_t h = static_cast<int32_t>(Num(mag).div(n).shift(10).u32());
+    int32_t h = static_cast<int32_t>(div_frac(mag, n, 10));
     if (clockwise) h = -h;
     rotation(h, a_.rot);
     int32_t x = h >> 2;
@@ -243,42 +354,39 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     return true;
 }
 
-void CurveWalker::bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const {
-    // B(a) (with `point`) and B'(a) / 2^j, 3 x the arm of the piece that starts or ends there
-    // (ticks x 256), by de Casteljau's algorithm: every value stays within the control points'
-    // hull.
+void CurveWalker::bezier_at(uint16_t at, int32_t point[2], int32_t arm[2]) const {
+    // At a = at / 2^j (Q20): B(a) (with `point`) and B'(a) / 2^j, 3 x the arm of the piece that
+    // starts or ends there (ticks x 256), by de Casteljau's algorithm: every value stays within
+    // the control points' hull.
+    const uint32_t a_q20 = static_cast<uint32_t>(at) << (20 - log_pieces_);
     for (uint8_t k = 0; k < 2; ++k) {
         int32_t q[4];
-        for (uint8_t i = 0; i < 4; ++i) q[i] = pts_[k][i];
+        memcpy(q, pts_[k], sizeof(q));
         for (uint8_t n = 3; n > 1; --n) {
             for (uint8_t i = 0; i < n; ++i) q[i] = lerp(q[i], q[i + 1], a_q20);
         }
-        if (point) point[k] = lerp(q[0], q[1], a_q20);
+        point[k] = lerp(q[0], q[1], a_q20);
         // B'(a) = 3 (q1 - q0), with q1 - q0 below 2^31 in magnitude (as the points' differences).
         int32_t d = static_cast<int32_t>(static_cast<uint32_t>(q[1]) - static_cast<uint32_t>(q[0]));
-        arm[k] = static_cast<int32_t>((static_cast<int64_t>(d) * 3) >> log_pieces_);
+        arm[k] = mul_shift(d, 3, log_pieces_);
     }
 }
 
 bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2_q8[2]) {
     kind_ = 0;
     uint32_t bound = 0; // hodograph bound (power basis), ticks
+    const int32_t* src[4] = {e.start_q8, p1_q8, p2_q8, e.end_q8};
     for (uint8_t k = 0; k < 2; ++k) {
-        int32_t* q = pts_[k];
-        q[0] = e.start_q8[k];
-        q[1] = p1_q8[k];
-        q[2] = p2_q8[k];
-        q[3] = e.end_q8[k];
         // B'(a) = 3 D1 + 6 D2 a + 3 D3 a^2 (D: the forward differences of the points, ticks).
         int32_t d[4];
-        for (uint8_t i = 0; i < 4; ++i) d[i] = q[i] >> 8;
+        for (uint8_t i = 0; i < 4; ++i) d[i] = (pts_[k][i] = src[i][k]) >> 8;
         differences(d);
-        uint32_t b = 3 * (abs32(d[1]) + 2 * abs32(d[2]) + abs32(d[3]));
+        uint32_t b = 3 * (uabs(d[1]) + 2 * uabs(d[2]) + uabs(d[3]));
         if (b > bound) bound = b;
     }
     // 2^j pieces, each with a hodograph bound below kMaxPieceTicks (it shrinks with 2^j).
     uint8_t j = 0;
-    while ((bound >> j) >= kMaxPieceTicks) {
+    for (; bound >= kMaxPieceTicks; bound >>= 1) {
         if (j == 15) return false;
         ++j;
     }
@@ -294,7 +402,8 @@ bool CurveWalker::next_piece() {
     --pieces_;
     bool last = pieces_ == 0;
     // The end of the piece on the curve and 3 x its arms at both ends, ticks x 256.
-    int32_t p3[3], arm0[3], arm3[3];
+    Piece g;
+    int32_t *p3 = g.p3, *arm0 = g.arm0, *arm3 = g.arm3;
     // Helix: w moves linearly (arms of a third of its move), the last piece landing exactly on
     // the end.
     int32_t w3 = dw_q8_;
@@ -309,62 +418,56 @@ bool CurveWalker::next_piece() {
         int32_t* dir = a_.dir[0];
         arc_at(dir, p3, arm0);
         rotate(dir, a_.rot);
-        if (last) { // land on the end point's direction: no drift left over
-            dir[0] = a_.dir[1][0];
-            dir[1] = a_.dir[1][1];
-        }
+        if (last) memcpy(dir, a_.dir[1], sizeof(a_.dir[1])); // no drift left over
         arc_at(dir, p3, arm3);
     } else {
         // Bezier part [a, a + 1/n]: the curve's ends and tangents.
-        uint32_t a0 = static_cast<uint32_t>(index) << (20 - log_pieces_);
-        bezier_at(a0, nullptr, arm0); // (the start is the last piece's end)
-        bezier_at(a0 + (1ul << (20 - log_pieces_)), p3, arm3);
-        if (last) { // the commanded end
-            p3[0] = pts_[0][3];
-            p3[1] = pts_[1][3];
-        }
+        bezier_at(index, p3, arm0); // (its point, the last piece's end, is overwritten)
+        // (At a = 1 every step of de Casteljau's algorithm gives its right point exactly: the
+        // last piece ends on the commanded end.)
+        bezier_at(static_cast<uint16_t>(index + 1), p3, arm3);
     }
-    start_piece(p3, arm0, arm3);
+    start_piece(g);
     return true;
 }
 
 bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
     moved = neg = 0;
-    while (left_ == 0) {
+    if (left_ == 0) { // (a piece has at least one sample)
         if (kind_ == 0) return false;
-        if (!next_piece()) {
-            // Last step: from the rounded end of the curve to the exact target (at most one
-            // tick per axis: both are within 0.71 tick of the curve's end point).
-            kind_ = 0;
-            break;
-        }
+        // Last step: from the rounded end of the curve to the exact target (at most one tick
+        // per axis: both are within 0.71 tick of the curve's end point).
+        if (!next_piece()) kind_ = 0;
     }
-    for (uint8_t a = 0; a < 3; ++a) {
+    const bool walking = kind_ != 0;
+    const uint8_t axes = walking ? axes_ : 3;
+    uint8_t bits = 0, down = 0, bit = 1;
+    for (uint8_t a = 0; a < axes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         int32_t p = end_[a];
-        if (kind_ != 0) {
-            if (a == axes_) break;
+        if (walking) {
             int64_t* v = fd_[a];
             fd_step(v);
             // round(f / 2^40) from the high word: floor((hi + 2^7) / 2^8). The word is read
             // from memory: avr-gcc would shift the 64 bits through a library loop.
             int32_t hi;
             memcpy(&hi, reinterpret_cast<const uint8_t*>(v) + 4, 4);
-            p = base_[a] + ((hi + 128) >> 8);
+            p = (hi + 128) >> 8;
         }
         if (p != pos[a]) {
-            const uint8_t bit = static_cast<uint8_t>(1u << a);
-            moved = static_cast<uint8_t>(moved | bit);
-            if (p < pos[a]) neg = static_cast<uint8_t>(neg | bit);
+            bits = static_cast<uint8_t>(bits | bit);
+            if (p < pos[a]) down = static_cast<uint8_t>(down | bit);
             pos[a] = p;
         }
     }
-    if (kind_ == 0) return moved != 0;
+    moved = bits;
+    neg = down;
+    if (!walking) return bits != 0;
     --left_;
     return true;
 }
 
 uint16_t CurveWalker::peek(int32_t d[3]) {
-    while (left_ == 0 && kind_ != 0 && pieces_ != 0) next_piece();
+    if (left_ == 0 && kind_ != 0) next_piece(); // (a piece has at least one sample)
     // d1 / 2^24 (below 2^17): bits 24 to 55 of the little-endian word.
     for (uint8_t a = 0; a < 3; ++a) {
         memcpy(&d[a], reinterpret_cast<const uint8_t*>(&fd_[a][1]) + 3, 4);
@@ -389,6 +492,7 @@ struct Track {
     bool bezier;
     bool clockwise; ///< ellipse: the angle decreases
     bool w_down;    ///< w decreases along the curve
+    bool w_counts;  ///< w's travel counts in the length
     union {
         struct {
             int32_t r[2];      ///< radii
@@ -400,26 +504,16 @@ struct Track {
         } b;                 ///< Bezier
     };
     Num rise; ///< |dw / dparameter|: the helix' rise
-    Num ww;   ///< rise^2 when w counts in the length, else 0
-    Num rmin; ///< Bezier: smallest radius of curvature met so far (0: none)
+    Num rmin; ///< Bezier: smallest radius of curvature met so far (at first 2^100: none)
 };
 
 // Shifts v[0..n-1] left or right so that the largest magnitude is in [2^27, 2^28); the shift.
 int8_t normalise(int32_t* v, uint8_t n) {
     uint32_t big = 0;
-    for (uint8_t i = 0; i < n; ++i) {
-        if (abs32(v[i]) > big) big = abs32(v[i]);
-    }
-    int8_t sh = 0;
+    for (uint8_t i = 0; i < n; ++i) big |= uabs(v[i]); // the largest's top bit
     if (big == 0) return 0;
-    while (big >= (1ul << 28)) {
-        big >>= 1;
-        --sh;
-    }
-    while (big < (1ul << 27)) {
-        big <<= 1;
-        ++sh;
-    }
+    // big = m 2^e with m in [2^31, 2^32): its top bit is 31 + e, to be moved to bit 27.
+    const int8_t sh = static_cast<int8_t>(-4 - Num(big).e);
     for (uint8_t i = 0; i < n; ++i) {
         v[i] = sh < 0 ? v[i] >> -sh : static_cast<int32_t>(static_cast<uint32_t>(v[i]) << sh);
     }
@@ -440,31 +534,29 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
         }
         return;
     }
-    int32_t v[2] = {k.e.dir[0][0], k.e.dir[0][1]};
+    int32_t v[2];
+    memcpy(v, k.e.dir[0], sizeof(v));
     if (off) {
         int32_t rot[2], h = static_cast<int32_t>(off << 1);
         rotation(k.clockwise ? -h : h, rot);
         rotate(v, rot);
     }
-    if (move) {
-        k.e.dir[0][0] = v[0];
-        k.e.dir[0][1] = v[1];
-    }
-    // (-ru sin t, rv cos t), reversed when clockwise, and (-ru cos t, -rv sin t) (only its size
-    // is used).
-    if (k.clockwise) {
-        v[0] = -v[0];
-        v[1] = -v[1];
-    }
+    if (move) memcpy(k.e.dir[0], v, sizeof(v));
+    // (-ru sin t, rv cos t), reversed when clockwise, and (ru cos t, rv sin t) (-P'': only its
+    // size is used).
     for (uint8_t i = 0; i < 2; ++i) {
-        d1[i] = mul_q30(k.e.r[i], i ? v[0] : -v[1]);
+        int32_t a = v[1 - i];
+        if ((i != 0) == k.clockwise) a = -a;
+        d1[i] = mul_q30(k.e.r[i], a);
         d2[i] = mul_q30(k.e.r[i], v[i]);
     }
 }
 
-// |(x, y)| with z2 added under the root, for signed x, y.
-Num norm(const int32_t v[2], const Num& z2) {
-    return hypot(Num(abs32(v[0])), Num(abs32(v[1])), z2);
+// |(x, y)| for signed x, y, or with `with_rise` |(x, y, rise)|.
+__attribute__((noinline)) Num norm(const int32_t v[2], const Track& k, bool with_rise) {
+    Num q[3];
+    components(v, k.rise, q);
+    return root_sum_squares(q, with_rise ? 3 : 2);
 }
 
 // The unit tangent (P', w') / |(P', w')| at the current point, Q29. Where P' = 0 (a Bezier whose
@@ -477,12 +569,9 @@ void tangent(Track& k, int32_t out[3]) {
         const uint32_t in = kOneQ29 >> 12; // backwards from t = 1: modulo 2^32
         track_at(k, k.b.t ? static_cast<uint32_t>(0u - in) : in, false, d, d2);
     }
-    Num x(abs32(d[0])), y(abs32(d[1])), rr = k.rise;
-    Num n = hypot(x, y, rr.mul(k.rise));
-    if (n.m == 0) return; // out stays 0
-    out[0] = unit_part(x, n, d[0] < 0, 29);
-    out[1] = unit_part(y, n, d[1] < 0, 29);
-    out[2] = unit_part(k.rise, n, k.w_down, 29);
+    Num q[3];
+    const uint8_t neg = components(d, k.rise, q);
+    unit_vector(q, 3, static_cast<uint8_t>(neg | k.w_down << 2), 29, out);
 }
 
 // The track at `off` (Q29) past its current point, which with `move` becomes the current one:
@@ -492,22 +581,22 @@ void tangent(Track& k, int32_t out[3]) {
 Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
     int32_t d1[2], d2[2];
     track_at(k, off, move, d1, d2);
-    Num n1 = norm(d1, Num{});
+    Num n1 = norm(d1, k, false);
     if (k.bezier) {
         // |P' x P''| / 2^30: both are below 2^30, and where the radius is smallest this keeps 20
         // bits.
         int32_t cross = mul_q30(d1[0], d2[1]) - mul_q30(d1[1], d2[0]);
         if (cross != 0) {
             Num rc = n1;
-            rc.mul(n1).mul(n1).div(abs32(cross)).shift(-30);
-            if (k.rmin.m == 0 || rc.cmp(k.rmin) < 0) k.rmin = rc;
+            rc.mul(n1).mul(n1).div(uabs(cross)).shift(-30);
+            if (rc.cmp(k.rmin) < 0) k.rmin = rc;
         }
     }
     if (half) {
-        Num n2 = norm(d2, Num{});
+        Num n2 = norm(d2, k, false);
         *half = n2.m ? Num(n1).div(n2).shift(28).u32() : 0xFFFFFFFFul; // P'' = 0: a line
     }
-    return k.ww.m ? norm(d1, k.ww) : n1;
+    return k.w_counts ? norm(d1, k, true) : n1;
 }
 
 // Length of the track over `span` (Q29) from its current point, x 2^29 x 18 x 2^scale: panels
@@ -517,9 +606,12 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
 // end, and these crowd where the curve turns tightly.
 Num track_length(Track& k, uint32_t span, uint32_t widest) {
     Num total{};
-    uint32_t w;
-    probe(k, 0, false, &w);
-    while (span != 0) {
+    uint32_t half, w = 0;
+    for (;;) {
+        probe(k, w, true, &half); // the end of the last panel (at first, the start: w = 0)
+        span -= w;
+        if (span == 0) break;
+        w = half; // in a register: half's address is taken
         if (w > widest) w = widest;
         if (w < kNarrowestQ29) w = kNarrowestQ29;
         if (w > span) w = span;
@@ -528,8 +620,6 @@ Num track_length(Track& k, uint32_t span, uint32_t widest) {
         Num sum = probe(k, g, false, nullptr);
         sum.add(probe(k, w - g, false, nullptr)).mul(5).add(probe(k, w / 2, false, nullptr).mul(8));
         total.add(sum.mul(w));
-        span -= w;
-        probe(k, w, true, &w);
     }
     return total;
 }
@@ -543,7 +633,11 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     uint32_t span = kOneQ29, widest = kWidestBezierQ29;
     uint8_t turns = 0;
     bool circle = false;
-    Num len{};
+    // The length, and |dw| (a circular helix' length is their root sum of squares).
+    Num ld[2];
+    Num& len = ld[0]; // (set below: an arc's in closed form, or by quadrature)
+    // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
+    k.rise = ld[1].set(uabs(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
         if (r[0] == 0 || r[1] == 0) return false;
@@ -552,18 +646,17 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         span = arc_directions(cp.start_um, cp.end_um, cp.a_um, r, k.clockwise, k.e.dir);
         widest = kWidestArcQ29;
         turns = cp.turns;
-        len = Num(kTurnQ29, -29).mul(turns).add(Num(span, -29));
+        len.set(kTurnQ29, -29).mul(turns).add(Num(span, -29));
         // w rises linearly with the angle: dw / |sweep| per radian.
-        k.rise = Num(abs32(dw_um)).div(len);
-        k.e.r[0] = static_cast<int32_t>(r[0]);
-        k.e.r[1] = static_cast<int32_t>(r[1]);
+        k.rise.div(len);
+        memcpy(k.e.r, r, sizeof(k.e.r));
         scale = normalise(k.e.r, 2);
         const uint32_t lo = r[0] < r[1] ? r[0] : r[1];
         const uint32_t hi = r[0] ^ r[1] ^ lo;
         out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
         circle = lo == hi;
         len.mul(lo); // a circle: r |sweep|, and a helix: sqrt(plane^2 + dw^2)
-        if (w_regulated) len = hypot(len, Num(abs32(dw_um)), Num{});
+        if (w_regulated) len = root_sum_squares(ld, 2);
     } else {
         // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
@@ -577,13 +670,10 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         }
         scale = normalise(&k.b.h[0][0], 6);
         k.bezier = true;
-        k.rise = Num(abs32(dw_um));
+        k.rmin.set(1, 100); // above any radius, and within range after the scale
     }
     k.rise.shift(scale);
-    if (w_regulated) {
-        k.ww = k.rise;
-        k.ww.mul(k.rise);
-    }
+    k.w_counts = w_regulated;
     tangent(k, out.start_dir);
     if (!circle) { // ellipses and Beziers by quadrature
         len = track_length(k, span, widest);
@@ -592,11 +682,9 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         len.div(18).shift(static_cast<int8_t>(-29 - scale));
     }
     if (k.bezier) {
-        out.min_radius_um =
-            k.rmin.m ? k.rmin.shift(static_cast<int8_t>(-scale)).u32() : 0xFFFFFFFFul;
+        out.min_radius_um = k.rmin.shift(static_cast<int8_t>(-scale)).u32(); // none: saturates
     } else {
-        k.e.dir[0][0] = k.e.dir[1][0];
-        k.e.dir[0][1] = k.e.dir[1][1];
+        memcpy(k.e.dir[0], k.e.dir[1], sizeof(k.e.dir[0]));
     }
     tangent(k, out.end_dir);
     if (len.m == 0) return false;
@@ -607,9 +695,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
 } // namespace
 
 bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
-    Track k{};
-    out.start_dir[0] = out.start_dir[1] = out.start_dir[2] = 0;
-    out.end_dir[0] = out.end_dir[1] = out.end_dir[2] = 0;
+    Track k{}; // (out's tangents are written in full: unit_vector() gives 0 for a null vector)
     return shape(cp, dw_um, w_regulated && dw_um != 0, out, k);
 }
 

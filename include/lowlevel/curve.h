@@ -6,9 +6,9 @@
 // values, with N larger than the piece's largest axis speed (its hodograph bound), so that two
 // consecutive samples are at most one tick apart on every axis: the visited positions are the
 // samples rounded to the nearest tick, strictly successive, within 0.71 tick of the piece.
-// Samples are produced by forward differencing in 64-bit fixed point (Q40 ticks, relative to
-// the piece start): three additions per axis and per sample, no multiplication, no square root,
-// and since N is a power of two the differences are set up with shifts.
+// Samples are produced by forward differencing in 64-bit fixed point (Q40 ticks): three
+// additions per axis and per sample, no multiplication, no square root, and since N is a power
+// of two the differences are set up with shifts.
 //
 // Arcs and ellipses (X = cu + ru cos t, Y = cv + rv sin t, docs/curves.md): pieces of at most
 // 21.5 degrees (and 2000 ticks), each the cubic whose arms are 4/3 tan(h/4) long, which stays
@@ -112,24 +112,26 @@ class CurveWalker {
   private:
     void begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind);
     bool next_piece();
-    void start_piece(const int32_t p3[3], const int32_t arm0[3], const int32_t arm3[3]);
+    /// A piece: its end and 3 x its arms at both ends, ticks x 256 (u, v, w).
+    struct Piece {
+        int32_t p3[3], arm0[3], arm3[3];
+    };
+    void start_piece(const Piece& g);
     void arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const;
-    void bezier_at(uint32_t a_q20, int32_t point[2], int32_t arm[2]) const;
+    void bezier_at(uint16_t at, int32_t point[2], int32_t arm[2]) const;
 
-    // Current piece, per axis: the position and its forward differences (f, d1, d2, d3), Q40
-    // ticks relative to base_.
-    int64_t fd_[3][4];
-    int32_t base_[3];
-    uint16_t left_;
+    // The small fields first, the forward differences last: on the ATmega328P a field within 63
+    // bytes of the object is reached by displacement, one beyond costs a pointer computation.
+    uint16_t left_; ///< samples left in the current piece
     // Curve
     uint8_t kind_;          ///< 0 done, 1 arc, 2 bezier
     uint8_t axes_;          ///< axes walked: 2 (u, v), or 3 when w moves (a helix)
     uint16_t pieces_;       ///< pieces not started yet
     uint16_t piece_count_;  ///< pieces in the curve
-    int32_t end_[3];        ///< final position, ticks
-    int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
-    int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
     uint8_t log_pieces_;    ///< Bezier: 2^j pieces
+    int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
+    int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
+    int32_t end_[3];        ///< final position, ticks
     // An arc or a Bezier, never both.
     struct ArcState {
         int32_t centre[2];
@@ -142,6 +144,9 @@ class CurveWalker {
         ArcState a_;
         int32_t pts_[2][4]; ///< Bezier: control points, u then v, ticks x 256
     };
+    // Current piece, per axis: the position and its forward differences (f, d1, d2, d3), Q40
+    // ticks.
+    int64_t fd_[3][4];
 };
 
 } // namespace ll
