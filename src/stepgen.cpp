@@ -128,39 +128,43 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     if (!um_q8_per_step_) return false;
     ln_.g.m = 0;
     lens_valid_ = false; // the curve's state overwrites the lines
-    plane_axes(c.plane, cv_.axes);
+    // plane_axes(): (u, v, w) = (X, Y, Z), (Z, X, Y), (Y, Z, X), i.e. axis (k - plane) mod 3.
+    for (uint8_t k = 0, a = static_cast<uint8_t>(3 - c.plane); k < 3; ++k, ++a) {
+        if (a >= 3) a = static_cast<uint8_t>(a - 3);
+        cv_.axes[k] = a;
+    }
     // The path is timed along the regulated axes only (seed §3.1): the plane's, and the normal
     // axis' when it belongs to the group (the planner measured the length the same way).
-    cv_.chord = 0;
-    for (uint8_t k = 0; k < 3; ++k) {
-        if (k < 2 || (spec.group & (1u << cv_.axes[k])))
-            cv_.chord = static_cast<uint8_t>(cv_.chord | (1u << k));
-    }
+    cv_.chord = (spec.group >> cv_.axes[2]) & 1 ? 7 : 3;
     // Machine positions (ticks) and commanded points of the plane (ticks x 256) for the walker:
     // µm x steps per µm, i.e. x 256 / (µm x 256 per step).
     CurveWalker::Ends e;
-    int32_t centre[2], other[2];
-    uint32_t radii[2];
     for (uint8_t k = 0; k < 3; ++k) {
         uint8_t a = cv_.axes[k];
         e.start[k] = start_[a];
         e.end[k] = start_[a] + spec.delta[a];
     }
+    // The commanded points: start and end into e, then a and b (arc: centre and semi-axes).
+    int32_t ab[2][2];
     for (uint8_t k = 0; k < 2; ++k) {
         Num per_um(65536);
         per_um.div(um_q8_per_step_[cv_.axes[k]]); // ticks x 256 per µm
-        auto to_q8 = [&](int32_t um) {
-            int32_t v = static_cast<int32_t>(per_um.of(abs32(um)));
-            return um < 0 ? -v : v;
-        };
-        e.start_q8[k] = to_q8(c.start_um[k]);
-        e.end_q8[k] = to_q8(c.end_um[k]);
-        centre[k] = to_q8(c.a_um[k]);
-        other[k] = to_q8(c.b_um[k]);
-        radii[k] = static_cast<uint32_t>(abs32(other[k]));
+        for (uint8_t i = 0; i < 4; ++i) {
+            const int32_t* um = i == 0 ? c.start_um : i == 1 ? c.end_um : i == 2 ? c.a_um : c.b_um;
+            int32_t* q8 = i == 0 ? e.start_q8 : i == 1 ? e.end_q8 : ab[i - 2];
+            int32_t v = static_cast<int32_t>(per_um.of(abs32(um[k])));
+            q8[k] = um[k] < 0 ? -v : v;
+        }
     }
-    bool ok = c.kind == kCurveArc ? cv_.w.arc(e, centre, radii, c.clockwise != 0, c.turns)
-                                  : cv_.w.bezier(e, centre, other);
+    bool ok;
+    if (c.kind == kCurveArc) {
+        // The semi-axes are lengths: b's magnitudes (signed and unsigned ints may alias).
+        uint32_t* radii = reinterpret_cast<uint32_t*>(ab[1]);
+        for (uint8_t k = 0; k < 2; ++k) radii[k] = abs32(ab[1][k]);
+        ok = cv_.w.arc(e, ab[0], radii, c.clockwise != 0, c.turns);
+    } else {
+        ok = cv_.w.bezier(e, ab[0], ab[1]);
+    }
     if (!ok) return false;
     curve_ = &c;
     // The profile's reference axis is a virtual one with 1000 ticks per mm (µm) along the path.
