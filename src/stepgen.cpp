@@ -24,6 +24,12 @@ uint32_t max3(uint32_t a, uint32_t b, uint32_t c) {
     return m > c ? m : c;
 }
 
+// x (1 - f), f in Q20 with |f| <= 1/4: x - floor(x f) for f > 0, x + floor(x |f|) otherwise.
+__attribute__((noinline)) uint32_t less(uint32_t x, int32_t f) {
+    uint32_t p = mul_shr(x, abs32(f), 20);
+    return f > 0 ? x - p : x + p;
+}
+
 } // namespace
 
 void StepGen::configure(const StepLengths* lengths, uint16_t min_period,
@@ -456,9 +462,7 @@ void StepGen::fill_line(RunQueue& q) {
             if (corr > (1l << 18)) corr = 1l << 18; // at most a quarter: no jolt
             if (corr < -(1l << 18)) corr = -(1l << 18);
         }
-        uint32_t d = delta;
-        if (corr > 0) d -= mul_shr(delta, static_cast<uint32_t>(corr), 20);
-        if (corr < 0) d += mul_shr(delta, static_cast<uint32_t>(-corr), 20);
+        const uint32_t d = corr ? less(delta, corr) : delta;
         // At cruise (most segments of a job) the periods are the move's constants.
         const bool at_cruise = delta == prof_.cruise;
         const bool constants = at_cruise && corr == 0;
@@ -471,11 +475,7 @@ void StepGen::fill_line(RunQueue& q) {
         }
         if (tracked) {
             // What this segment took, in K units of the uncorrected Delta_1: sum x (1 - corr).
-            int32_t took = static_cast<int32_t>(sum);
-            if (corr > 0)
-                took -= static_cast<int32_t>(mul_shr(sum, static_cast<uint32_t>(corr), 20));
-            if (corr < 0)
-                took += static_cast<int32_t>(mul_shr(sum, static_cast<uint32_t>(-corr), 20));
+            int32_t took = static_cast<int32_t>(less(sum, corr));
             ln_.k_err += took - (static_cast<int32_t>(len) << 20);
         }
 #if LL_STATS
