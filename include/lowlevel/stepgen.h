@@ -175,24 +175,24 @@ class StepGen {
     uint8_t seen_head_;
     uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
     uint16_t min_period_;
-    uint32_t origin_;     ///< reference tick where the profile starts (moves after a resume)
-    uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
-    uint32_t a_last_;     ///< A of the last segment
+    // The move being produced: a line or a curve, never both, so they share their memory.
+    const CurveParams* curve_;
+    uint32_t origin_;   ///< reference tick where the profile starts (moves after a resume)
+    uint32_t a_last_;   ///< A of the last segment
+    uint32_t x2_decel_; ///< where the end deceleration starts, half ticks from origin_
+    Profile prof_;
+    SqrtTracker root_;
     uint32_t delta_root_; ///< d_num / R for the current R
     // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
     uint32_t a_hold_;
     uint32_t x2_hold_;
     uint32_t handover_v2_;
-    Profile prof_;
-    SqrtTracker root_;
     Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
     // What remains needed of the MoveSpec after begin().
     uint32_t len_q8_, feed_, v_nominal2_, v_exit2_;
     Num dv2_; ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
-    // The move being produced: a line or a curve, never both, so they share their memory.
-    const CurveParams* curve_;
     struct LineState {
         LineGeometry g;
         LineCursor c;
