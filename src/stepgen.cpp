@@ -552,6 +552,14 @@ void StepGen::fill_curve(RunQueue& q) {
     }
 }
 
+uint32_t StepGen::ref_len() const {
+    return curve_ ? cv_.ref_um : ln_.g.dist[0];
+}
+
+uint32_t StepGen::progress() const {
+    return curve_ ? (cv_.x_q8 >> 8) : ln_.c.x1;
+}
+
 uint8_t StepGen::fill(RunQueue& q) {
     uint8_t pushed_before = q.used();
     if (curve_) {

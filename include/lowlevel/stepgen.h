@@ -156,12 +156,10 @@ class StepGen {
     void fill_line(RunQueue& q);
     void fill_curve(RunQueue& q);
     void finish_move();
-    uint32_t ref_len() const {
-        return curve_ ? cv_.ref_um : ln_.g.dist[0];
-    }
-    uint32_t progress() const {
-        return curve_ ? (cv_.x_q8 >> 8) : ln_.c.x1;
-    }
+    /// The move's reference length and the reference ticks produced (out of line: one call is
+    /// smaller than the test of curve_ and the far member reads).
+    uint32_t ref_len() const;
+    uint32_t progress() const;
 
     // Most used first: the ATmega328P addresses the first 64 bytes of an object directly.
     bool active_;
