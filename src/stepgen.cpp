@@ -368,27 +368,24 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
     }
 }
 
-bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
+uint32_t StepGen::delta_at(uint32_t x2) {
     if (cruising_ && !holding_) {
         a_last_ = prof_.a_cruise; // profile_a(x2) == a_cruise: no evaluation
-        delta = prof_.cruise;
-        return true;
+        return prof_.cruise;
     }
+    x2 -= 2 * origin_;
     uint32_t a = profile_a(prof_, x2);
     if (holding_) {
         uint32_t dec = shl_sat(x2 - x2_hold_, static_cast<uint8_t>(prof_.log_s - 1));
         if (dec >= a_hold_) {
             stopped_ = true; // the speed reaches zero before this point
-            return false;
+            return 0;
         }
         uint32_t ah = a_hold_ - dec;
         if (ah < a) a = ah;
     }
     a_last_ = a;
-    if (a == prof_.a_cruise && !holding_) {
-        delta = prof_.cruise;
-        return true;
-    }
+    if (a == prof_.a_cruise && !holding_) return prof_.cruise;
     bool changed = !root_valid_;
     if (!root_valid_) {
         root_.reset(a);
@@ -402,9 +399,9 @@ bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
         ++stats.divisions;
 #endif
     }
-    delta = delta_root_;
+    uint32_t delta = delta_root_;
     if (a <= prof_.a_cruise && delta < prof_.cruise) delta = prof_.cruise;
-    return true;
+    return delta;
 }
 
 uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest) {
@@ -436,8 +433,8 @@ void StepGen::fill_line(RunQueue& q) {
         if (horizon_full(q)) break;
         uint32_t left = ln_.g.dist[0] - ln_.c.x1;
         uint8_t len = left < seg_len_ ? static_cast<uint8_t>(left) : seg_len_;
-        uint32_t delta;
-        if (!delta_at(2 * (ln_.c.x1 - origin_) + len, delta)) break; // segment midpoint
+        const uint32_t delta = delta_at(2 * ln_.c.x1 + len); // segment midpoint
+        if (stopped_) break;
         uint8_t e[kAxes];
         line_advance(ln_.g, ln_.c, len, e);
         MicroRun runs[kAxes];
@@ -516,8 +513,8 @@ void StepGen::fill_curve(RunQueue& q) {
         uint8_t n = seg_len_ < cap ? seg_len_ : cap;
         if (left != 0 && left < n) n = static_cast<uint8_t>(left);
         uint32_t mid = cv_.x_q8 + chord_q8 * n / 2;
-        uint32_t delta;
-        if (!delta_at(2 * ((mid >> 8) - origin_), delta)) break;
+        const uint32_t delta = delta_at(2 * (mid >> 8));
+        if (stopped_) break;
         // Delta (cycles x 256 per µm) x chord (µm x 256) / 256.
         uint32_t period_q8 = mul_shr(delta, chord_q8, 8);
         // Samples of the same axes and directions make one run.

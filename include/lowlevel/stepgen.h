@@ -147,9 +147,9 @@ class StepGen {
     /// Queues one run and counts its duration (1024-cycle units) in the horizon.
     void push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint16_t period,
               uint8_t units);
-    /// Delta_1 (cycles x 256 per reference unit) at half-unit position x2; false when a hold
-    /// brings the speed to zero before x2.
-    bool delta_at(uint32_t x2, uint32_t& delta);
+    /// Delta_1 (cycles x 256 per reference unit) at half-unit position x2 of the move (origin_
+    /// not taken out); sets stopped_ when a hold brings the speed to zero before x2.
+    uint32_t delta_at(uint32_t x2);
     /// Length of the next segment, reference units: the shortest power of two lasting
     /// kSegmentCycles at `delta`, 1 when `longest` (the largest period, x 256) needs idle waits.
     static uint8_t next_segment(uint32_t delta, uint32_t longest);
