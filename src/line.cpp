@@ -54,16 +54,9 @@ void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[k
     c.x1 += len;
     c.pos[0] += len;
     e[0] = len;
-    if (c.x1 == g.dist[0]) {
-        // Last segment: S_j * d_1 + P/2 lands within 1/16 tick of d_j + 1/2 by construction
-        // (|d_1 (S_j / P - s_j)| <= d_1 / (2P) <= 1/16), so the formula gives d_j exactly;
-        // writing it directly also saves the multiplication.
-        for (uint8_t j = 1; j < g.m; ++j) {
-            e[j] = static_cast<uint8_t>(g.dist[j] - c.pos[j]);
-            c.pos[j] = g.dist[j];
-        }
-        return;
-    }
+    // The last segment needs no special case: S_j * d_1 + P/2 lands within 1/16 tick of
+    // d_j + 1/2 by construction (|d_1 (S_j / P - s_j)| <= d_1 / (2P) <= 1/16), so the sum of the
+    // increments is d_j exactly.
     for (uint8_t j = 1; j < g.m; ++j) {
         // < 2^27 + 2^27 * 16 < 2^32; one tick per segment is the common case (no product)
         uint32_t acc = c.frac[j] + (len == 1 ? g.slope[j] : g.slope[j] * len);
