@@ -72,14 +72,14 @@ bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
 
 void StepGen::build_k_table(uint8_t group) {
     const uint8_t m = ln_.g.m;
-    const uint8_t sets = static_cast<uint8_t>(1u << (m - 1));
-    for (uint8_t sub = 0; sub < sets; ++sub) {
-        uint8_t mask = static_cast<uint8_t>(1u << ln_.g.axis[0]);
-        uint8_t bits = sub; // sorted position j in bit j - 1
-        for (uint8_t j = 1; j < m; ++j, bits >>= 1) {
-            if (bits & 1) mask = static_cast<uint8_t>(mask | (1u << ln_.g.axis[j]));
-        }
-        ln_.mask[sub] = mask;
+    // Machine-axis bits of each set: the sets with sorted position j (bit j - 1 of the index)
+    // are those without it plus its axis.
+    uint8_t* mask = ln_.mask;
+    mask[0] = static_cast<uint8_t>(1u << ln_.g.axis[0]);
+    uint8_t sets = 1;
+    for (uint8_t j = 1; j < m; ++j, sets = static_cast<uint8_t>(sets << 1)) {
+        const uint8_t bit = static_cast<uint8_t>(1u << ln_.g.axis[j]);
+        for (uint8_t s = 0; s < sets; ++s) mask[sets + s] = static_cast<uint8_t>(mask[s] | bit);
     }
     // Feed along the line (docs/motion.md): a line of d_1 micro steps takes len / V, so the
     // micro steps share that time in proportion to their regulated lengths L_P. Over the runs
@@ -100,8 +100,10 @@ void StepGen::build_k_table(uint8_t group) {
     }
     lens_valid_ = true;
     uint32_t sum_hi = 0, sum_lo = 0, count_g = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
-    for (uint8_t i = 0, set = 0; i < m; ++i, set = static_cast<uint8_t>(2 * set + 1)) {
-        uint32_t n = ln_.g.dist[i] - (i + 1 < m ? ln_.g.dist[i + 1] : 0);
+    uint32_t below = 0;                           // dist[i + 1], 0 past the last position
+    for (uint8_t i = m, set = static_cast<uint8_t>(sets - 1); i-- > 0; set >>= 1) {
+        uint32_t n = ln_.g.dist[i] - below;
+        below = ln_.g.dist[i];
         uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
         if (len != 0 && n != 0) {
             uint32_t lo, hi = mul_wide(n, len, lo);
@@ -117,11 +119,13 @@ void StepGen::build_k_table(uint8_t group) {
     }
     Num r(count_g, 20);
     r.div(num64(sum_hi, sum_lo));
-    ln_.kmax = 0;
+    uint32_t kmax = 0;
     for (uint8_t sub = 0; sub < sets; ++sub) {
-        ln_.k[sub] = lens[sub] != 0 ? r.of(lens[sub]) : 1ul << 20;
-        if (ln_.k[sub] > ln_.kmax) ln_.kmax = ln_.k[sub];
+        uint32_t k = lens[sub] != 0 ? r.of(lens[sub]) : 1ul << 20;
+        ln_.k[sub] = k;
+        if (k > kmax) kmax = k;
     }
+    ln_.kmax = kmax;
 }
 
 uint32_t StepGen::a_of(uint32_t v2) const {
