@@ -408,7 +408,7 @@ uint32_t StepGen::delta_at(uint32_t x2) {
     return delta;
 }
 
-uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest) {
+__attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest) {
     uint8_t next = 1;
     if (longest <= 0xFFFF00ul) {
         uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8; // / next: a shift
