@@ -206,11 +206,11 @@ class StepGen {
         uint8_t cruise_seg;                        ///< segment length at cruise
     };
     struct CurveState {
-        CurveWalker w;
         uint32_t ref_um; ///< its length, µm (the profile's reference length)
         uint32_t x_q8;   ///< distance travelled, µm x 256
         uint8_t axes[3]; ///< machine axes u, v, w
         uint8_t chord;   ///< bits (u = 1, v = 2, w = 4) of the axes the path is timed along
+        CurveWalker w;
     };
     union {
         LineState ln_;
