@@ -192,10 +192,10 @@ class StepGen {
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
     struct LineState {
-        LineGeometry g;
-        LineCursor c;
         uint32_t kmax; ///< largest K of the move
         int32_t k_err; ///< K-time emitted beyond len x Delta_1 so far, Q20 (see fill_line)
+        LineGeometry g;
+        LineCursor c;
         uint32_t k[1u << (kAxes - 1)];   ///< K table, Q20 (see k())
         uint8_t mask[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
         // Step length of each sorted set (restricted to the regulated group), kept from one
