@@ -226,13 +226,11 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     // Chains of moves mostly enter and leave at their cruise speed: one product then.
     prof_.a_cruise = a_of(v_nominal2_);
     prof_.a_entry = v_entry2 == v_nominal2_ ? prof_.a_cruise : a_of(v_entry2);
-    prof_.a_exit = v_exit2 == v_nominal2_ ? prof_.a_cruise : a_of(v_exit2);
-    if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
+    set_a_exit(v_exit2);
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
     Num fd(feed_);
     prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(fd.mul(d1)).u32();
-    mark_profile();
     root_valid_ = false;
     if (!curve_) {
         // The runs' periods at cruise, for fill_line (one product per axis set and move).
@@ -244,7 +242,9 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     }
 }
 
-void StepGen::mark_profile() {
+void StepGen::set_a_exit(uint32_t v_exit2) {
+    uint32_t a = v_exit2 == v_nominal2_ ? prof_.a_cruise : a_of(v_exit2);
+    prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
     // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
     // A_cruise everywhere and the end deceleration starts at its end (what profile_x2_decel
     // gives then). Chains of short moves are made of such moves.
@@ -254,12 +254,10 @@ void StepGen::mark_profile() {
 
 void StepGen::set_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
-    if (v_exit2 == v_exit2_) return;                     // called at every poll: usually no change
-    if (2 * (progress() - origin_) >= x2_decel_) return; // end deceleration already begun
+    if (v_exit2 == v_exit2_) return;   // called at every poll: usually no change
+    if (x2_now() >= x2_decel_) return; // end deceleration already begun
     v_exit2_ = v_exit2;
-    prof_.a_exit = a_of(v_exit2);
-    if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
-    mark_profile();
+    set_a_exit(v_exit2);
 }
 
 void StepGen::hold() {
@@ -267,7 +265,7 @@ void StepGen::hold() {
     holding_ = true;
     if (active_) {
         a_hold_ = a_last_;
-        x2_hold_ = 2 * (progress() - origin_);
+        x2_hold_ = x2_now();
     }
 }
 
@@ -559,6 +557,10 @@ uint32_t StepGen::ref_len() const {
 
 uint32_t StepGen::progress() const {
     return curve_ ? (cv_.x_q8 >> 8) : ln_.c.x1;
+}
+
+uint32_t StepGen::x2_now() const {
+    return 2 * (progress() - origin_);
 }
 
 uint8_t StepGen::fill(RunQueue& q) {

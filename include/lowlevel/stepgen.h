@@ -139,8 +139,9 @@ class StepGen {
     bool start_profile(const MoveSpec& spec, uint32_t ticks);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
-    /// Sets x2_decel_ and cruising_ from prof_.
-    void mark_profile();
+    /// Sets prof_.a_exit for the exit speed v_exit2 (at most A_cruise), then x2_decel_ and
+    /// cruising_ from prof_.
+    void set_a_exit(uint32_t v_exit2);
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
     /// queued_cycles(q) >= kHorizonCycles.
     bool horizon_full(const RunQueue& q);
@@ -160,6 +161,8 @@ class StepGen {
     /// smaller than the test of curve_ and the far member reads).
     uint32_t ref_len() const;
     uint32_t progress() const;
+    /// Where the last segment ended, half ticks from origin_.
+    uint32_t x2_now() const;
 
     // Most used first: the ATmega328P addresses the first 64 bytes of an object directly.
     bool active_;
@@ -168,7 +171,7 @@ class StepGen {
     bool have_handover_;
     bool root_valid_;
     bool lens_valid_; ///< ln_.lens holds step lengths (no curve ran since, same settings)
-    bool cruising_;   ///< the profile is at cruise from end to end (mark_profile())
+    bool cruising_;   ///< the profile is at cruise from end to end (set_a_exit())
     uint8_t seg_len_;
     uint8_t seen_head_;
     uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
