@@ -502,8 +502,9 @@ void StepGen::fill_curve(RunQueue& q) {
         int32_t d[3];
         uint16_t left = cv_.w.peek(d);
         Num sum{};
-        for (uint8_t k = 0; k < 3; ++k) {
-            if (!(cv_.chord & (1u << k))) continue;
+        uint8_t chord = cv_.chord;
+        for (uint8_t k = 0; k < 3; ++k, chord >>= 1) {
+            if (!(chord & 1)) continue;
             Num v(abs32(d[k]));
             v.mul(v).mul(lengths_->inv2[cv_.axes[k]]);
             sum.add(v);
@@ -519,17 +520,16 @@ void StepGen::fill_curve(RunQueue& q) {
         // Delta (cycles x 256 per µm) x chord (µm x 256) / 256.
         uint32_t period_q8 = mul_shr(delta, chord_q8, 8);
         // Samples of the same axes and directions make one run.
+        // (u, v, w) bits to machine-axis bits: axis (k - plane) mod 3 (begin_curve) is a
+        // rotation of the three bits by plane = 2 - axes[2] to the right.
+        const uint8_t plane = static_cast<uint8_t>(2 - cv_.axes[2]);
         uint8_t run_steps = 0, run_dirs = 0, run_count = 0;
         uint8_t i = 0;
         for (; i < n; ++i) {
             uint8_t moved, neg;
             if (!cv_.w.next(moved, neg)) break;
-            uint8_t steps = 0, dirs = 0;
-            for (uint8_t k = 0; k < 3; ++k, moved >>= 1, neg >>= 1) {
-                uint8_t bit = static_cast<uint8_t>(1u << cv_.axes[k]);
-                if (moved & 1) steps = static_cast<uint8_t>(steps | bit);
-                if (neg & 1) dirs = static_cast<uint8_t>(dirs | bit);
-            }
+            const uint8_t steps = static_cast<uint8_t>(((moved * 9u) >> plane) & 7);
+            const uint8_t dirs = static_cast<uint8_t>(((neg * 9u) >> plane) & 7);
             if (run_count != 0 && (steps != run_steps || (steps && dirs != run_dirs))) {
                 emit(q, run_steps, run_dirs, run_count, period_q8);
                 run_count = 0;
