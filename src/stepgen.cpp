@@ -154,7 +154,9 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
         e.start[k] = start_[a];
         e.end[k] = start_[a] + spec.delta[a];
     }
-    // The commanded points: start and end into e, then a and b (arc: centre and semi-axes).
+    // The commanded points: start and end into e, then a and b (arc: centre and semi-axes, of
+    // which only the magnitudes count; Bezier: control points).
+    const bool arc = c.kind == kCurveArc;
     int32_t ab[2][2];
     for (uint8_t k = 0; k < 2; ++k) {
         Num per_um(65536);
@@ -162,19 +164,15 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
         for (uint8_t i = 0; i < 4; ++i) {
             const int32_t* um = i == 0 ? c.start_um : i == 1 ? c.end_um : i == 2 ? c.a_um : c.b_um;
             int32_t* q8 = i == 0 ? e.start_q8 : i == 1 ? e.end_q8 : ab[i - 2];
-            int32_t v = static_cast<int32_t>(per_um.of(abs32(um[k])));
-            q8[k] = um[k] < 0 ? -v : v;
+            const int32_t x = um[k];
+            int32_t v = static_cast<int32_t>(per_um.of(abs32(x)));
+            q8[k] = x < 0 && !(arc && i == 3) ? -v : v;
         }
     }
-    bool ok;
-    if (c.kind == kCurveArc) {
-        // The semi-axes are lengths: b's magnitudes (signed and unsigned ints may alias).
-        uint32_t* radii = reinterpret_cast<uint32_t*>(ab[1]);
-        for (uint8_t k = 0; k < 2; ++k) radii[k] = abs32(ab[1][k]);
-        ok = cv_.w.arc(e, ab[0], radii, c.clockwise != 0, c.turns);
-    } else {
-        ok = cv_.w.bezier(e, ab[0], ab[1]);
-    }
+    // The semi-axes as unsigned values (signed and unsigned ints may alias).
+    bool ok =
+        arc ? cv_.w.arc(e, ab[0], reinterpret_cast<uint32_t*>(ab[1]), c.clockwise != 0, c.turns)
+            : cv_.w.bezier(e, ab[0], ab[1]);
     if (!ok) return false;
     curve_ = &c;
     // The profile's reference axis is a virtual one with 1000 ticks per mm (µm) along the path.
