@@ -180,17 +180,18 @@ class StepGen {
     const CurveParams* curve_;
     uint32_t origin_;   ///< reference tick where the profile starts (moves after a resume)
     uint32_t a_last_;   ///< A of the last segment
-    uint32_t x2_decel_; ///< where the end deceleration starts, half ticks from origin_
     Profile prof_;
     SqrtTracker root_;
     uint32_t delta_root_; ///< d_num / R for the current R
+    uint32_t v_exit2_;    ///< exit speed squared, (mm/min)^2 (MoveSpec)
+    uint32_t x2_decel_; ///< where the end deceleration starts, half ticks from origin_
     // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
     uint32_t a_hold_;
     uint32_t x2_hold_;
     uint32_t handover_v2_;
     Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
     // What remains needed of the MoveSpec after begin().
-    uint32_t len_q8_, feed_, v_nominal2_, v_exit2_;
+    uint32_t len_q8_, feed_, v_nominal2_;
     Num dv2_; ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
