@@ -235,7 +235,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
         for (uint8_t sub = 0; sub < sets; ++sub) {
             ln_.cruise_period[sub] = mul_shr(prof_.cruise, ln_.k[sub], 20);
         }
-        ln_.cruise_seg = next_segment(prof_.cruise, mul_shr(prof_.cruise, ln_.kmax, 20));
+        ln_.cruise_seg = next_segment(prof_.cruise, ln_.kmax);
     }
 }
 
@@ -403,9 +403,12 @@ uint32_t StepGen::delta_at(uint32_t x2) {
     return delta;
 }
 
-__attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest) {
+__attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t k) {
     uint8_t next = 1;
-    if (longest <= 0xFFFF00ul) {
+    // A tick lasting kSegmentCycles already makes a one-tick segment, whatever the longest
+    // period: its product is only needed below that (and never for k = 0: delta itself).
+    if (delta < static_cast<uint32_t>(kSegmentCycles) << 8 &&
+        (k == 0 || mul_shr(delta, k, 20) <= 0xFFFF00ul)) {
         uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8; // / next: a shift
         while (next < kMaxSegmentTicks && delta < target) {
             next = static_cast<uint8_t>(next << 1);
@@ -477,12 +480,7 @@ void StepGen::fill_line(RunQueue& q) {
 #if LL_STATS
         ++stats.segments;
 #endif
-        // A tick lasting kSegmentCycles already makes a one-tick segment, whatever the longest
-        // period: its product is only needed below that.
-        seg_len_ = at_cruise ? ln_.cruise_seg
-                   : delta >= static_cast<uint32_t>(kSegmentCycles) << 8
-                       ? 1
-                       : next_segment(delta, mul_shr(delta, ln_.kmax, 20));
+        seg_len_ = at_cruise ? ln_.cruise_seg : next_segment(delta, ln_.kmax);
         if (ln_.c.x1 == ln_.g.dist[0]) finish_move();
     }
 }
@@ -543,7 +541,7 @@ void StepGen::fill_curve(RunQueue& q) {
 #if LL_STATS
         ++stats.segments;
 #endif
-        seg_len_ = next_segment(period_q8 < 1 ? 1 : period_q8, period_q8);
+        seg_len_ = next_segment(period_q8, 0); // the longest period is period_q8 itself
         if (cv_.w.done()) finish_move();
     }
 }

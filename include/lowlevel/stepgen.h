@@ -152,8 +152,9 @@ class StepGen {
     /// not taken out); sets stopped_ when a hold brings the speed to zero before x2.
     uint32_t delta_at(uint32_t x2);
     /// Length of the next segment, reference units: the shortest power of two lasting
-    /// kSegmentCycles at `delta`, 1 when `longest` (the largest period, x 256) needs idle waits.
-    static uint8_t next_segment(uint32_t delta, uint32_t longest);
+    /// kSegmentCycles at `delta`, 1 when the longest period (delta x k, k the largest K in Q20;
+    /// cycles x 256; k = 0: delta itself) needs idle waits.
+    static uint8_t next_segment(uint32_t delta, uint32_t k);
     void fill_line(RunQueue& q);
     void fill_curve(RunQueue& q);
     void finish_move();
@@ -178,13 +179,13 @@ class StepGen {
     uint16_t min_period_;
     // The move being produced: a line or a curve, never both, so they share their memory.
     const CurveParams* curve_;
-    uint32_t origin_;   ///< reference tick where the profile starts (moves after a resume)
-    uint32_t a_last_;   ///< A of the last segment
+    uint32_t origin_; ///< reference tick where the profile starts (moves after a resume)
+    uint32_t a_last_; ///< A of the last segment
     Profile prof_;
     SqrtTracker root_;
     uint32_t delta_root_; ///< d_num / R for the current R
     uint32_t v_exit2_;    ///< exit speed squared, (mm/min)^2 (MoveSpec)
-    uint32_t x2_decel_; ///< where the end deceleration starts, half ticks from origin_
+    uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
     // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
     uint32_t a_hold_;
     uint32_t x2_hold_;
