@@ -481,7 +481,7 @@ void StepGen::fill_line(RunQueue& q) {
         ++stats.segments;
 #endif
         seg_len_ = at_cruise ? ln_.cruise_seg : next_segment(delta, ln_.kmax);
-        if (ln_.c.x1 == ln_.g.dist[0]) finish_move();
+        if (left == len) finish_move(); // the line's end reached
     }
 }
 
