@@ -505,9 +505,9 @@ void StepGen::fill_curve(RunQueue& q) {
             v.mul(v).mul(lengths_->inv2[cv_.axes[k]]);
             sum.add(v);
         }
-        // mm over 2^16 -> µm x 256: x 256000 / 2^16 = 0xFA000000 x 2^-28 (mul() would take
-        // 256000 as 0xFA000000 x 2^-12, then the shift)
-        uint32_t chord_q8 = sum.sqrt().mulc(0xFA000000ul, -28).u32();
+        // mm over 2^16 -> µm x 256: x 256000 / 2^16 = 0xFA000000 x 2^-30 (mul() would take
+        // 256000 as 0xFA000000 x 2^-14, then the shift)
+        uint32_t chord_q8 = sum.sqrt().mulc(0xFA000000ul, -30).u32();
         if (chord_q8 == 0) chord_q8 = 1;
         uint8_t n = seg_len_ < cap ? seg_len_ : cap;
         if (left != 0 && left < n) n = static_cast<uint8_t>(left);
