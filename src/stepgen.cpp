@@ -199,15 +199,13 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     //   d_1^2;
     // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD len_q8 sqrt(psi),
     //   kD = 2 kSqrtCHalf / sqrt(2^7 128000).
+    Num phi(d1);
     Num psi(1);
-    {
-        Num t(d1);
-        psi.div(t.mul(dv2_));
-    }
-    Num phi = psi;
+    psi.div(phi.mul(dv2_));
+    phi = psi;
     phi.mul(d1).mul(d1);
     Num dn = psi;
-    dn.sqrt().mul(len_q8_).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
+    dn.sqrt().mul(Num(len_q8_)).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
     uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);
@@ -226,8 +224,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     set_a_exit(v_exit2);
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
-    Num fd(feed_);
-    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(fd.mul(d1)).u32();
+    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(phi.set(feed_).mul(d1)).u32();
     root_valid_ = false;
     if (!curve_) {
         // The runs' periods at cruise, for fill_line (one product per axis set and move).
