@@ -145,7 +145,9 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     }
     // The path is timed along the regulated axes only (seed §3.1): the plane's, and the normal
     // axis' when it belongs to the group (the planner measured the length the same way).
-    cv_.chord = (spec.group >> cv_.axes[2]) & 1 ? 7 : 3;
+    uint8_t w_bit = static_cast<uint8_t>(cv_.axes[2] + 1); // 1 << axes[2], axes[2] <= 2
+    if (w_bit == 3) w_bit = 4;
+    cv_.chord = spec.group & w_bit ? 7 : 3;
     // Machine positions (ticks) and commanded points of the plane (ticks x 256) for the walker:
     // µm x steps per µm, i.e. x 256 / (µm x 256 per step).
     CurveWalker::Ends e;
