@@ -340,14 +340,16 @@ void StepGen::push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
 }
 
 void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8) {
-    uint32_t period = period_q8 > 0xFFFFFF7Ful ? 0xFFFFFFul : (period_q8 + 128) >> 8;
+    // Rounded to cycles, at most kMaxPeriodCycles (compared before rounding: no overflow).
+    static_assert(kMaxPeriodCycles < 1ul << 24, "kMaxPeriodCycles << 8 fits 32 bits");
+    uint32_t period =
+        period_q8 >= kMaxPeriodCycles << 8 ? kMaxPeriodCycles : (period_q8 + 128) >> 8;
     if (period < min_period_) {
         period = min_period_;
 #if LL_STATS
         ++stats.clamped;
 #endif
     }
-    if (period > kMaxPeriodCycles) period = kMaxPeriodCycles;
     if (period <= 0xFFFF) {
         // >> 10 as a byte move and two shifts (avr-gcc 5.4 makes a 10-turn loop of it)
         const uint16_t p16 = static_cast<uint16_t>(period);
