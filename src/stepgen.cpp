@@ -358,9 +358,10 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
     } else {
         // Below 245 steps/s: each event is preceded by idle waits (steps == 0) so that every
         // compare value fits the 16-bit timer without changing its prescaler.
-        uint32_t parts = (period + kIdleChunk - 1) / kIdleChunk;
-        uint16_t each = static_cast<uint16_t>(period / parts);
-        uint16_t last = static_cast<uint16_t>(period - (parts - 1) * each);
+        const uint16_t parts = static_cast<uint16_t>(div32_16(period + kIdleChunk - 1, kIdleChunk));
+        const uint16_t each = static_cast<uint16_t>(div32_16(period, parts));
+        const uint16_t last =
+            static_cast<uint16_t>(period - static_cast<uint32_t>(parts - 1u) * each);
         for (uint8_t i = 0; i < count; ++i) {
             push(q, 0, dirs, static_cast<uint8_t>(parts - 1), each, 255);
             push(q, steps, dirs, 1, last, 63);
