@@ -454,12 +454,12 @@ void StepGen::fill_line(RunQueue& q) {
         const bool tracked = ln_.g.m > 2;
         int32_t corr = 0; // per tick, Q20 of the mean K (1.0): the next ticks last (1 - corr)
         if (tracked) {
-            uint8_t sh = 0; // spread over the segment length in force (not a short last one)
-            while ((2u << sh) <= seg_len_) ++sh;
             const int32_t band = 1l << 19;
-            int32_t over = ln_.k_err > band ? ln_.k_err - band : 0;
-            if (ln_.k_err < -band) over = ln_.k_err + band;
-            corr = over >> sh;                      // arithmetic shift
+            const int32_t err = ln_.k_err;
+            corr = err > band ? err - band : 0;
+            if (err < -band) corr = err + band;
+            // spread over the segment length in force (a power of two; not a short last one)
+            for (uint8_t l = seg_len_; l > 1; l = static_cast<uint8_t>(l >> 1)) corr >>= 1;
             if (corr > (1l << 18)) corr = 1l << 18; // at most a quarter: no jolt
             if (corr < -(1l << 18)) corr = -(1l << 18);
         }
