@@ -276,8 +276,7 @@ void StepGen::resume(uint32_t v_exit2) {
 }
 
 uint32_t StepGen::speed2() const {
-    if (a_last_ == 0 || a_per_v2_.m == 0) return 0;
-    return Num(a_last_).div(a_per_v2_).u32();
+    return Num(a_last_).div(a_per_v2_).u32(); // 0 when either is (Num::div gives 0 then)
 }
 
 void StepGen::pushed_position(int32_t out[kAxes]) const {
