@@ -28,7 +28,8 @@ uint32_t max3(uint32_t a, uint32_t b, uint32_t c) {
 __attribute__((noinline)) uint32_t less(uint32_t x, int32_t f) {
     if (f == 0) return x; // the common case: no product
     uint32_t p = mul_shr(x, abs32(f), 20);
-    return f > 0 ? x - p : x + p;
+    if (f > 0) p = 0 - p;
+    return x + p;
 }
 
 } // namespace
