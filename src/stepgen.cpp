@@ -77,11 +77,14 @@ void StepGen::build_k_table(uint8_t group) {
     // Machine-axis bits of each set: the sets with sorted position j (bit j - 1 of the index)
     // are those without it plus its axis.
     uint8_t* mask = ln_.mask;
-    mask[0] = static_cast<uint8_t>(1u << ln_.g.axis[0]);
+    // (the reference axis joins the empty set in place).
+    mask[0] = 0;
     uint8_t sets = 1;
-    for (uint8_t j = 1; j < m; ++j, sets = static_cast<uint8_t>(sets << 1)) {
+    for (uint8_t j = 0; j < m; ++j) {
         const uint8_t bit = static_cast<uint8_t>(1u << ln_.g.axis[j]);
-        for (uint8_t s = 0; s < sets; ++s) mask[sets + s] = static_cast<uint8_t>(mask[s] | bit);
+        const uint8_t to = j ? sets : 0;
+        for (uint8_t s = 0; s < sets; ++s) mask[to + s] = static_cast<uint8_t>(mask[s] | bit);
+        if (j) sets = static_cast<uint8_t>(sets << 1);
     }
     // Feed along the line (docs/motion.md): a line of d_1 micro steps takes len / V, so the
     // micro steps share that time in proportion to their regulated lengths L_P. Over the runs
