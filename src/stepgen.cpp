@@ -75,9 +75,8 @@ bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
 void StepGen::build_k_table(uint8_t group) {
     const uint8_t m = ln_.g.m;
     // Machine-axis bits of each set: the sets with sorted position j (bit j - 1 of the index)
-    // are those without it plus its axis.
+    // are those without it plus its axis (the reference axis joins the empty set in place).
     uint8_t* mask = ln_.mask;
-    // (the reference axis joins the empty set in place).
     mask[0] = 0;
     uint8_t sets = 1;
     for (uint8_t j = 0; j < m; ++j) {
