@@ -317,7 +317,8 @@ void StepGen::abort() {
 
 uint32_t StepGen::queued_cycles(const RunQueue& q) {
     horizon_full(q);
-    return static_cast<uint32_t>(queued_) << 10;
+    // queued_ < 16 x 255 < 2^14: << 2 in 16 bits, then << 8 as a byte move
+    return static_cast<uint32_t>(static_cast<uint16_t>(queued_ << 2)) << 8;
 }
 
 bool StepGen::horizon_full(const RunQueue& q) {
