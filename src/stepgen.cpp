@@ -535,8 +535,13 @@ void StepGen::fill_curve(RunQueue& q) {
         for (; i < n; ++i) {
             uint8_t moved, neg;
             if (!cv_.w.next(moved, neg)) break;
-            const uint8_t steps = static_cast<uint8_t>(((moved * 9u) >> plane) & 7);
-            const uint8_t dirs = static_cast<uint8_t>(((neg * 9u) >> plane) & 7);
+            uint8_t steps = static_cast<uint8_t>(moved * 9u), dirs = static_cast<uint8_t>(neg * 9u);
+            for (uint8_t p = plane; p; --p) {
+                steps = static_cast<uint8_t>(steps >> 1);
+                dirs = static_cast<uint8_t>(dirs >> 1);
+            }
+            steps &= 7;
+            dirs &= 7;
             if (run_count != 0 && (steps != run_steps || (steps && dirs != run_dirs))) {
                 emit(q, run_steps, run_dirs, run_count, period_q8);
                 run_count = 0;
