@@ -293,10 +293,13 @@ void StepGen::pushed_position(int32_t out[kAxes]) const {
         for (uint8_t k = 0; k < 3; ++k) out[cv_.axes[k]] = cv_.w.pos[k];
         return;
     }
-    for (uint8_t j = 0; j < ln_.g.m; ++j) {
-        uint8_t a = ln_.g.axis[j];
-        int32_t p = static_cast<int32_t>(ln_.c.pos[j]);
-        out[a] += ((ln_.g.dirs >> a) & 1) ? -p : p;
+    const uint8_t* axis = ln_.g.axis;
+    const uint32_t* pos = ln_.c.pos;
+    const uint8_t dirs = ln_.g.dirs;
+    for (uint8_t j = ln_.g.m; j; --j) {
+        uint8_t a = *axis++;
+        int32_t p = static_cast<int32_t>(*pos++);
+        out[a] += ((dirs >> a) & 1) ? -p : p;
     }
 }
 
