@@ -44,9 +44,11 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
 
 void line_start(const LineGeometry& g, LineCursor& c) {
     c.x1 = 0;
-    for (uint8_t j = 0; j < g.m; ++j) {
-        c.pos[j] = 0;
-        c.frac[j] = 1ul << (kLineUnit - 1); // P/2
+    uint32_t* pos = c.pos;
+    uint32_t* frac = c.frac;
+    for (uint8_t j = g.m; j; --j) {
+        *pos++ = 0;
+        *frac++ = 1ul << (kLineUnit - 1); // P/2
     }
 }
 
