@@ -124,9 +124,11 @@ void StepGen::build_k_table(uint8_t group) {
     Num r(count_g, 20);
     r.div(num64(sum_hi, sum_lo));
     uint32_t kmax = 0;
-    for (uint8_t sub = 0; sub < sets; ++sub) {
-        uint32_t k = lens[sub] != 0 ? r.of(lens[sub]) : 1ul << 20;
-        ln_.k[sub] = k;
+    uint32_t* kp = ln_.k;
+    for (uint8_t sub = sets; sub; --sub) {
+        const uint32_t len = *lens++;
+        const uint32_t k = len != 0 ? r.of(len) : 1ul << 20;
+        *kp++ = k;
         if (k > kmax) kmax = k;
     }
     ln_.kmax = kmax;
