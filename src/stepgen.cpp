@@ -481,10 +481,11 @@ void StepGen::fill_line(RunQueue& q) {
         const bool at_cruise = delta == prof_.cruise;
         const bool constants = at_cruise && corr == 0;
         uint32_t sum = 0;
-        for (uint8_t i = 0; i < n; ++i) {
-            uint8_t idx = static_cast<uint8_t>(runs[i].set >> 1);
-            if (tracked) sum += runs[i].count * ln_.k[idx];
-            emit(q, ln_.mask[idx], ln_.g.dirs, runs[i].count,
+        for (const MicroRun* r = runs; n; --n, ++r) {
+            const uint8_t idx = static_cast<uint8_t>(r->set >> 1);
+            const uint8_t count = r->count;
+            if (tracked) sum += count * ln_.k[idx];
+            emit(q, ln_.mask[idx], ln_.g.dirs, count,
                  constants ? ln_.cruise_period[idx] : mul_shr(d, ln_.k[idx], 20));
         }
         if (tracked) {
