@@ -200,8 +200,8 @@ void StepGen::take_spec(const MoveSpec& spec) {
     feed_ = spec.feed;
     v_nominal2_ = spec.v_nominal2;
     v_exit2_ = spec.v_exit2;
-    dv2_.set(spec.dv2);
-    if (!spec.dv2) dv2_.set(spec.len_q8).mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
+    dv2_.set(spec.dv2 ? spec.dv2 : spec.len_q8);
+    if (!spec.dv2) dv2_.mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
 }
 
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
