@@ -189,10 +189,11 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     if (!ok) return false;
     curve_ = &c;
     // The profile's reference axis is a virtual one with 1000 ticks per mm (µm) along the path.
-    cv_.ref_um = spec.len_q8 >> 8;
-    if (cv_.ref_um == 0) cv_.ref_um = 1;
+    uint32_t ref_um = spec.len_q8 >> 8;
+    if (ref_um == 0) ref_um = 1;
+    cv_.ref_um = ref_um;
     cv_.x_q8 = 0;
-    return start_profile(spec, cv_.ref_um);
+    return start_profile(spec, ref_um);
 }
 
 void StepGen::take_spec(const MoveSpec& spec) {
