@@ -492,7 +492,8 @@ void StepGen::fill_line(RunQueue& q) {
         if (tracked) {
             // What this segment took, in K units of the uncorrected Delta_1: sum x (1 - corr).
             int32_t took = static_cast<int32_t>(less(sum, corr));
-            ln_.k_err += took - (static_cast<int32_t>(len) << 20);
+            // len << 20 as (len << 4) << 16: a byte move, not twenty shifts
+            ln_.k_err += took - static_cast<int32_t>(static_cast<uint32_t>(len << 4) << 16);
         }
 #if LL_STATS
         ++stats.segments;
