@@ -367,7 +367,10 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
     if (period <= 0xFFFF) {
         // >> 10 as a byte move and two shifts (avr-gcc 5.4 makes a 10-turn loop of it)
         const uint16_t p16 = static_cast<uint16_t>(period);
-        uint32_t units = ((static_cast<uint32_t>(p16) * count) >> 8) >> 2; // 16 x 8 bits, < 2^14
+        // 16 x 8 bits < 2^24; >> 10 as a byte move (into 16 bits) and two shifts: avr-gcc 5.4
+        // makes a 10-turn loop of a 32-bit >> 10
+        const uint16_t units =
+            static_cast<uint16_t>((static_cast<uint32_t>(p16) * count) >> 8) >> 2;
         push(q, steps, dirs, count, p16, units > 255 ? 255 : static_cast<uint8_t>(units));
     } else {
         // Below 245 steps/s: each event is preceded by idle waits (steps == 0) so that every
