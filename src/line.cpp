@@ -64,7 +64,9 @@ void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[k
         uint32_t acc = c.frac[j] + (len == 1 ? g.slope[j] : g.slope[j] * len);
         // acc >> 27 from the top byte: avr-gcc 5.4 makes a 27-turn loop of a 32-bit shift
         uint8_t top = static_cast<uint8_t>(acc >> 24);
-        uint8_t inc = static_cast<uint8_t>(top >> (kLineUnit - 24));
+        // (a division by the power of two: avr-gcc 5.4 shifts the byte; top >> 3 is promoted to
+        // int and made a 16-bit loop)
+        uint8_t inc = static_cast<uint8_t>(top / (1u << (kLineUnit - 24)));
         c.frac[j] = acc & ((1ul << kLineUnit) - 1);
         c.pos[j] += inc;
         e[j] = inc;
