@@ -218,7 +218,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     psi.div(phi.mul(dv2_));
     phi = psi;
     phi.mul(d1).mul(d1);
-    Num dn = psi;
+    Num& dn = psi; // psi is not needed any more: D in its place
     dn.sqrt().mul(Num(len_q8_)).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
