@@ -213,9 +213,10 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     //   d_1^2;
     // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD len_q8 sqrt(psi),
     //   kD = 2 kSqrtCHalf / sqrt(2^7 128000).
-    Num phi(d1);
+    Num t(d1); // scratch
     Num psi(1);
-    psi.div(phi.mul(dv2_));
+    psi.div(t.mul(dv2_));
+    Num& phi = a_per_v2_; // phi in place: shifted to the profile's scale below
     phi = psi;
     phi.mul(d1).mul(d1);
     Num& dn = psi; // psi is not needed any more: D in its place
@@ -230,14 +231,14 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
         if (l_max <= lim && !d_full) break;
     }
     prof_.log_s = static_cast<uint8_t>(2 * m + 1);
-    a_per_v2_ = phi.shift(static_cast<int8_t>(prof_.log_s));
+    phi.shift(static_cast<int8_t>(prof_.log_s));
     prof_.d = remaining_ticks;
     prof_.a_cruise = a_of(v_nominal2_);
     prof_.a_entry = a_near(v_entry2);
     set_a_exit(v_exit2);
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
-    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(phi.set(feed_).mul(d1)).u32();
+    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(t.set(feed_).mul(d1)).u32();
     root_valid_ = false;
     if (!curve_) {
         // The runs' periods at cruise, for fill_line (one product per axis set and move).
