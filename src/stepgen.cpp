@@ -587,13 +587,14 @@ uint32_t StepGen::x2_now() const {
 }
 
 uint8_t StepGen::fill(RunQueue& q) {
-    uint8_t pushed_before = q.used();
+    // Runs pushed: how far the tail moved (the interrupt may move the head meanwhile).
+    const uint8_t tail = q.tail;
     if (curve_) {
         fill_curve(q);
     } else {
         fill_line(q);
     }
-    return static_cast<uint8_t>(q.used() - pushed_before);
+    return static_cast<uint8_t>((q.tail - tail) & (kRunQueueSize - 1));
 }
 
 } // namespace ll
