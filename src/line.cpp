@@ -25,7 +25,10 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
         g.axis[i] = a;
         ++g.m;
     }
-    if (g.m == 0 || g.dist[0] > kMaxLineTicks) return false;
+    if (g.m == 0 || g.dist[0] > kMaxLineTicks) {
+        g.m = 0; // refused: nothing to move
+        return false;
+    }
 
     // §7.2: P = 2^k, the smallest power of two with P >= 8 d_1.
     uint32_t d1 = g.dist[0];
