@@ -363,7 +363,6 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
 #endif
     }
     if (period <= 0xFFFF) {
-        // >> 10 as a byte move and two shifts (avr-gcc 5.4 makes a 10-turn loop of it)
         const uint16_t p16 = static_cast<uint16_t>(period);
         // 16 x 8 bits < 2^24; >> 10 as a byte move (into 16 bits) and two shifts: avr-gcc 5.4
         // makes a 10-turn loop of a 32-bit >> 10
