@@ -509,7 +509,7 @@ void StepGen::fill_curve(RunQueue& q) {
         // segment is cut short to what the queue can take.
         const uint8_t free = q.free_slots();
         if (free < 4) break;
-        const uint8_t cap = static_cast<uint8_t>((free - 2) / 2);
+        const uint8_t cap = static_cast<uint8_t>((free >> 1) - 1); // (free - 2) / 2, free >= 4
         if (horizon_full(q)) break;
         // The chord of the next sample sets the time of every sample of the segment (the
         // segment never crosses into the next piece, whose samples may be twice as long).
