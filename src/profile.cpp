@@ -36,27 +36,20 @@ void SqrtTracker::reset(uint32_t a) {
 }
 
 bool SqrtTracker::seek(uint32_t a) {
+    uint32_t before = r;
     // A few steps of R per macro segment; a long way (a new move, a feed hold) is a jump, where
     // one full square root is cheaper than walking: beyond 64 (R + 1) of A.
     uint32_t far = ((r + 1) << 8) >> 2; // byte move and two shifts, not a 6-turn loop
     if ((a > c ? a - c : c - a) > far) {
-        uint32_t before = r;
         reset(a);
-        return r != before;
+    } else {
+        for (uint32_t step = 2 * r + 1; a >= c + step; step += 2) { // (R + 1)^2 = R^2 + 2 R + 1
+            c += step;
+            ++r;
+        }
+        while (a < c) c -= 2 * --r + 1;
     }
-    uint32_t rr = r, cc = c;
-    for (uint32_t step = 2 * rr + 1; a >= cc + step; step += 2) { // (R + 1)^2 = R^2 + 2 R + 1
-        cc += step;
-        ++rr;
-    }
-    for (uint32_t step = 2 * rr - 1; a < cc; step -= 2) { // (R - 1)^2 = R^2 - 2 R + 1
-        cc -= step;
-        --rr;
-    }
-    c = cc;
-    bool changed = rr != r;
-    r = rr;
-    return changed;
+    return r != before;
 }
 
 } // namespace ll
