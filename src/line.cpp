@@ -25,12 +25,15 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
         g.axis[i] = a;
         ++g.m;
     }
-    if (g.m == 0 || g.dist[0] > kMaxLineTicks) return false;
+    if (g.m == 0 || g.dist[0] > kMaxLineTicks) {
+        g.m = 0; // refused: nothing to move
+        return false;
+    }
 
     // §7.2: P = 2^k, the smallest power of two with P >= 8 d_1.
     uint32_t d1 = g.dist[0];
     uint8_t k = 3;
-    for (uint32_t p = 8; p < 8ul * d1; p <<= 1) ++k; // not 1 << k: a shift loop per turn
+    for (uint32_t p = 1; p < d1; p <<= 1) ++k; // 2^(k - 3) >= d_1; not 1 << k: a shift loop
     g.shift = k;
     g.slope[0] = 1ul << kLineUnit;
     for (uint8_t j = 1; j < g.m; ++j) {
@@ -44,9 +47,11 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
 
 void line_start(const LineGeometry& g, LineCursor& c) {
     c.x1 = 0;
-    for (uint8_t j = 0; j < g.m; ++j) {
-        c.pos[j] = 0;
-        c.frac[j] = 1ul << (kLineUnit - 1); // P/2
+    uint32_t* pos = c.pos;
+    uint32_t* frac = c.frac;
+    for (uint8_t j = g.m; j; --j) {
+        *pos++ = 0;
+        *frac++ = 1ul << (kLineUnit - 1); // P/2
     }
 }
 
@@ -54,22 +59,17 @@ void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[k
     c.x1 += len;
     c.pos[0] += len;
     e[0] = len;
-    if (c.x1 == g.dist[0]) {
-        // Last segment: S_j * d_1 + P/2 lands within 1/16 tick of d_j + 1/2 by construction
-        // (|d_1 (S_j / P - s_j)| <= d_1 / (2P) <= 1/16), so the formula gives d_j exactly;
-        // writing it directly also saves the multiplication.
-        for (uint8_t j = 1; j < g.m; ++j) {
-            e[j] = static_cast<uint8_t>(g.dist[j] - c.pos[j]);
-            c.pos[j] = g.dist[j];
-        }
-        return;
-    }
+    // The last segment needs no special case: S_j * d_1 + P/2 lands within 1/16 tick of
+    // d_j + 1/2 by construction (|d_1 (S_j / P - s_j)| <= d_1 / (2P) <= 1/16), so the sum of the
+    // increments is d_j exactly.
     for (uint8_t j = 1; j < g.m; ++j) {
         // < 2^27 + 2^27 * 16 < 2^32; one tick per segment is the common case (no product)
         uint32_t acc = c.frac[j] + (len == 1 ? g.slope[j] : g.slope[j] * len);
         // acc >> 27 from the top byte: avr-gcc 5.4 makes a 27-turn loop of a 32-bit shift
         uint8_t top = static_cast<uint8_t>(acc >> 24);
-        uint8_t inc = static_cast<uint8_t>(top >> (kLineUnit - 24));
+        // (a division by the power of two: avr-gcc 5.4 shifts the byte; top >> 3 is promoted to
+        // int and made a 16-bit loop)
+        uint8_t inc = static_cast<uint8_t>(top / (1u << (kLineUnit - 24)));
         c.frac[j] = acc & ((1ul << kLineUnit) - 1);
         c.pos[j] += inc;
         e[j] = inc;

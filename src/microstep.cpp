@@ -20,24 +20,24 @@ uint8_t micro_split(const uint8_t e[], uint8_t m, MicroRun out[]) {
         order[i] = j;
         ++n;
     }
-    uint8_t runs = 0;
+    MicroRun* o = out;
     uint8_t done = 0; // micro steps emitted so far
     for (uint8_t i = 0; i < n; ++i) {
         uint8_t j = order[i];
         if (e[j] > done) {
-            out[runs].set = set;
-            out[runs].count = static_cast<uint8_t>(e[j] - done);
-            ++runs;
+            o->set = set;
+            o->count = static_cast<uint8_t>(e[j] - done);
+            ++o;
             done = e[j];
         }
         set = static_cast<uint8_t>(set & ~(1u << j)); // axis j has reached its target
     }
     if (e[0] > done) {
-        out[runs].set = set;
-        out[runs].count = static_cast<uint8_t>(e[0] - done);
-        ++runs;
+        o->set = set;
+        o->count = static_cast<uint8_t>(e[0] - done);
+        ++o;
     }
-    return runs;
+    return static_cast<uint8_t>(o - out);
 }
 
 } // namespace ll

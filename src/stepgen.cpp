@@ -24,6 +24,14 @@ uint32_t max3(uint32_t a, uint32_t b, uint32_t c) {
     return m > c ? m : c;
 }
 
+// x (1 - f), f in Q20 with |f| <= 1/4: x - floor(x f) for f > 0, x + floor(x |f|) otherwise.
+__attribute__((noinline)) uint32_t less(uint32_t x, int32_t f) {
+    if (f == 0) return x; // the common case: no product
+    uint32_t p = mul_shr(x, abs32(f), 20);
+    if (f > 0) p = 0 - p;
+    return x + p;
+}
+
 } // namespace
 
 void StepGen::configure(const StepLengths* lengths, uint16_t min_period,
@@ -38,10 +46,7 @@ bool StepGen::begin(const MoveSpec& spec) {
     pushed_position(start_); // the previous move is complete: start from its end
     curve_ = nullptr;
     if (spec.curve) return begin_curve(spec);
-    if (!line_setup(ln_.g, spec.delta)) {
-        ln_.g.m = 0;
-        return false;
-    }
+    if (!line_setup(ln_.g, spec.delta)) return false; // (it leaves m = 0)
     line_start(ln_.g, ln_.c);
     build_k_table(spec.group);
     ln_.k_err = 0;
@@ -66,14 +71,16 @@ bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
 
 void StepGen::build_k_table(uint8_t group) {
     const uint8_t m = ln_.g.m;
-    const uint8_t sets = static_cast<uint8_t>(1u << (m - 1));
-    for (uint8_t sub = 0; sub < sets; ++sub) {
-        uint8_t mask = static_cast<uint8_t>(1u << ln_.g.axis[0]);
-        uint8_t bits = sub; // sorted position j in bit j - 1
-        for (uint8_t j = 1; j < m; ++j, bits >>= 1) {
-            if (bits & 1) mask = static_cast<uint8_t>(mask | (1u << ln_.g.axis[j]));
-        }
-        ln_.mask[sub] = mask;
+    // Machine-axis bits of each set: the sets with sorted position j (bit j - 1 of the index)
+    // are those without it plus its axis (the reference axis joins the empty set in place).
+    uint8_t* mask = ln_.mask;
+    mask[0] = 0;
+    uint8_t sets = 1;
+    for (uint8_t j = 0; j < m; ++j) {
+        const uint8_t bit = static_cast<uint8_t>(1u << ln_.g.axis[j]);
+        const uint8_t to = j ? sets : 0;
+        for (uint8_t s = 0; s < sets; ++s) mask[to + s] = static_cast<uint8_t>(mask[s] | bit);
+        if (j) sets = static_cast<uint8_t>(sets << 1);
     }
     // Feed along the line (docs/motion.md): a line of d_1 micro steps takes len / V, so the
     // micro steps share that time in proportion to their regulated lengths L_P. Over the runs
@@ -94,8 +101,10 @@ void StepGen::build_k_table(uint8_t group) {
     }
     lens_valid_ = true;
     uint32_t sum_hi = 0, sum_lo = 0, count_g = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
-    for (uint8_t i = 0, set = 0; i < m; ++i, set = static_cast<uint8_t>(2 * set + 1)) {
-        uint32_t n = ln_.g.dist[i] - (i + 1 < m ? ln_.g.dist[i + 1] : 0);
+    uint32_t below = 0;                           // dist[i + 1], 0 past the last position
+    for (uint8_t i = m, set = static_cast<uint8_t>(sets - 1); i-- > 0; set >>= 1) {
+        uint32_t n = ln_.g.dist[i] - below;
+        below = ln_.g.dist[i];
         uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
         if (len != 0 && n != 0) {
             uint32_t lo, hi = mul_wide(n, len, lo);
@@ -111,11 +120,15 @@ void StepGen::build_k_table(uint8_t group) {
     }
     Num r(count_g, 20);
     r.div(num64(sum_hi, sum_lo));
-    ln_.kmax = 0;
-    for (uint8_t sub = 0; sub < sets; ++sub) {
-        ln_.k[sub] = lens[sub] != 0 ? r.of(lens[sub]) : 1ul << 20;
-        if (ln_.k[sub] > ln_.kmax) ln_.kmax = ln_.k[sub];
+    uint32_t kmax = 0;
+    uint32_t* kp = ln_.k;
+    for (uint8_t sub = sets; sub; --sub) {
+        const uint32_t len = *lens++;
+        const uint32_t k = len != 0 ? r.of(len) : 1ul << 20;
+        *kp++ = k;
+        if (k > kmax) kmax = k;
     }
+    ln_.kmax = kmax;
 }
 
 uint32_t StepGen::a_of(uint32_t v2) const {
@@ -123,51 +136,61 @@ uint32_t StepGen::a_of(uint32_t v2) const {
     return a > kMaxA ? kMaxA : a;
 }
 
+uint32_t StepGen::a_near(uint32_t v2) const {
+    // Chains of moves mostly enter and leave at their cruise speed: no product then.
+    return v2 == v_nominal2_ ? prof_.a_cruise : a_of(v2);
+}
+
 bool StepGen::begin_curve(const MoveSpec& spec) {
     const CurveParams& c = *spec.curve;
     if (!um_q8_per_step_) return false;
     ln_.g.m = 0;
     lens_valid_ = false; // the curve's state overwrites the lines
-    plane_axes(c.plane, cv_.axes);
+    // plane_axes(): (u, v, w) = (X, Y, Z), (Z, X, Y), (Y, Z, X), i.e. axis (k - plane) mod 3.
+    for (uint8_t k = 0, a = static_cast<uint8_t>(3 - c.plane); k < 3; ++k, ++a) {
+        if (a >= 3) a = static_cast<uint8_t>(a - 3);
+        cv_.axes[k] = a;
+    }
     // The path is timed along the regulated axes only (seed §3.1): the plane's, and the normal
     // axis' when it belongs to the group (the planner measured the length the same way).
-    cv_.chord = 0;
-    for (uint8_t k = 0; k < 3; ++k) {
-        if (k < 2 || (spec.group & (1u << cv_.axes[k])))
-            cv_.chord = static_cast<uint8_t>(cv_.chord | (1u << k));
-    }
+    uint8_t w_bit = static_cast<uint8_t>(cv_.axes[2] + 1); // 1 << axes[2], axes[2] <= 2
+    if (w_bit == 3) w_bit = 4;
+    cv_.chord = spec.group & w_bit ? 7 : 3;
     // Machine positions (ticks) and commanded points of the plane (ticks x 256) for the walker:
     // µm x steps per µm, i.e. x 256 / (µm x 256 per step).
     CurveWalker::Ends e;
-    int32_t centre[2], other[2];
-    uint32_t radii[2];
     for (uint8_t k = 0; k < 3; ++k) {
         uint8_t a = cv_.axes[k];
         e.start[k] = start_[a];
         e.end[k] = start_[a] + spec.delta[a];
     }
+    // The commanded points: start and end into e, then a and b (arc: centre and semi-axes, of
+    // which only the magnitudes count; Bezier: control points).
+    const bool arc = c.kind == kCurveArc;
+    int32_t ab[2][2];
     for (uint8_t k = 0; k < 2; ++k) {
         Num per_um(65536);
         per_um.div(um_q8_per_step_[cv_.axes[k]]); // ticks x 256 per µm
-        auto to_q8 = [&](int32_t um) {
-            int32_t v = static_cast<int32_t>(per_um.of(abs32(um)));
-            return um < 0 ? -v : v;
-        };
-        e.start_q8[k] = to_q8(c.start_um[k]);
-        e.end_q8[k] = to_q8(c.end_um[k]);
-        centre[k] = to_q8(c.a_um[k]);
-        other[k] = to_q8(c.b_um[k]);
-        radii[k] = static_cast<uint32_t>(abs32(other[k]));
+        for (uint8_t i = 0; i < 4; ++i) {
+            const int32_t* um = i == 0 ? c.start_um : i == 1 ? c.end_um : i == 2 ? c.a_um : c.b_um;
+            int32_t* q8 = i == 0 ? e.start_q8 : i == 1 ? e.end_q8 : ab[i - 2];
+            const int32_t x = um[k];
+            int32_t v = static_cast<int32_t>(per_um.of(abs32(x)));
+            q8[k] = x < 0 && !(arc && i == 3) ? -v : v;
+        }
     }
-    bool ok = c.kind == kCurveArc ? cv_.w.arc(e, centre, radii, c.clockwise != 0, c.turns)
-                                  : cv_.w.bezier(e, centre, other);
+    // The semi-axes as unsigned values (signed and unsigned ints may alias).
+    bool ok =
+        arc ? cv_.w.arc(e, ab[0], reinterpret_cast<uint32_t*>(ab[1]), c.clockwise != 0, c.turns)
+            : cv_.w.bezier(e, ab[0], ab[1]);
     if (!ok) return false;
     curve_ = &c;
     // The profile's reference axis is a virtual one with 1000 ticks per mm (µm) along the path.
-    cv_.ref_um = spec.len_q8 >> 8;
-    if (cv_.ref_um == 0) cv_.ref_um = 1;
+    uint32_t ref_um = spec.len_q8 >> 8;
+    if (ref_um == 0) ref_um = 1;
+    cv_.ref_um = ref_um;
     cv_.x_q8 = 0;
-    return start_profile(spec, cv_.ref_um);
+    return start_profile(spec, ref_um);
 }
 
 void StepGen::take_spec(const MoveSpec& spec) {
@@ -175,8 +198,8 @@ void StepGen::take_spec(const MoveSpec& spec) {
     feed_ = spec.feed;
     v_nominal2_ = spec.v_nominal2;
     v_exit2_ = spec.v_exit2;
-    dv2_.set(spec.dv2);
-    if (!spec.dv2) dv2_.set(spec.len_q8).mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
+    dv2_.set(spec.dv2 ? spec.dv2 : spec.len_q8);
+    if (!spec.dv2) dv2_.mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
 }
 
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
@@ -187,15 +210,13 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     //   d_1^2;
     // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD len_q8 sqrt(psi),
     //   kD = 2 kSqrtCHalf / sqrt(2^7 128000).
-    Num psi(d1);
-    psi.mul(dv2_);
-    {
-        Num one(1);
-        psi = one.div(psi);
-    }
-    Num phi = psi;
+    Num t(d1); // scratch
+    Num psi(1);
+    psi.div(t.mul(dv2_));
+    Num& phi = a_per_v2_; // phi in place: shifted to the profile's scale below
+    phi = psi;
     phi.mul(d1).mul(d1);
-    Num dn = psi;
+    Num& dn = psi; // psi is not needed any more: D in its place
     dn.sqrt().mul(Num(len_q8_)).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
@@ -207,18 +228,14 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
         if (l_max <= lim && !d_full) break;
     }
     prof_.log_s = static_cast<uint8_t>(2 * m + 1);
-    a_per_v2_ = phi.shift(static_cast<int8_t>(prof_.log_s));
+    phi.shift(static_cast<int8_t>(prof_.log_s));
     prof_.d = remaining_ticks;
-    // Chains of moves mostly enter and leave at their cruise speed: one product then.
     prof_.a_cruise = a_of(v_nominal2_);
-    prof_.a_entry = v_entry2 == v_nominal2_ ? prof_.a_cruise : a_of(v_entry2);
-    prof_.a_exit = v_exit2 == v_nominal2_ ? prof_.a_cruise : a_of(v_exit2);
-    if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
+    prof_.a_entry = a_near(v_entry2);
+    set_a_exit(v_exit2);
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
-    Num fd(feed_);
-    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(fd.mul(d1)).u32();
-    mark_profile();
+    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(t.set(feed_).mul(d1)).u32();
     root_valid_ = false;
     if (!curve_) {
         // The runs' periods at cruise, for fill_line (one product per axis set and move).
@@ -226,11 +243,13 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
         for (uint8_t sub = 0; sub < sets; ++sub) {
             ln_.cruise_period[sub] = mul_shr(prof_.cruise, ln_.k[sub], 20);
         }
-        ln_.cruise_seg = next_segment(prof_.cruise, mul_shr(prof_.cruise, ln_.kmax, 20));
+        ln_.cruise_seg = next_segment(prof_.cruise, ln_.kmax);
     }
 }
 
-void StepGen::mark_profile() {
+void StepGen::set_a_exit(uint32_t v_exit2) {
+    uint32_t a = a_near(v_exit2);
+    prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
     // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
     // A_cruise everywhere and the end deceleration starts at its end (what profile_x2_decel
     // gives then). Chains of short moves are made of such moves.
@@ -240,12 +259,10 @@ void StepGen::mark_profile() {
 
 void StepGen::set_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
-    if (v_exit2 == v_exit2_) return;                     // called at every poll: usually no change
-    if (2 * (progress() - origin_) >= x2_decel_) return; // end deceleration already begun
+    if (v_exit2 == v_exit2_) return;   // called at every poll: usually no change
+    if (x2_now() >= x2_decel_) return; // end deceleration already begun
     v_exit2_ = v_exit2;
-    prof_.a_exit = a_of(v_exit2);
-    if (prof_.a_exit > prof_.a_cruise) prof_.a_exit = prof_.a_cruise;
-    mark_profile();
+    set_a_exit(v_exit2);
 }
 
 void StepGen::hold() {
@@ -253,7 +270,7 @@ void StepGen::hold() {
     holding_ = true;
     if (active_) {
         a_hold_ = a_last_;
-        x2_hold_ = 2 * (progress() - origin_);
+        x2_hold_ = x2_now();
     }
 }
 
@@ -268,8 +285,7 @@ void StepGen::resume(uint32_t v_exit2) {
 }
 
 uint32_t StepGen::speed2() const {
-    if (a_last_ == 0 || a_per_v2_.m == 0) return 0;
-    return Num(a_last_).div(a_per_v2_).u32();
+    return Num(a_last_).div(a_per_v2_).u32(); // 0 when either is (Num::div gives 0 then)
 }
 
 void StepGen::pushed_position(int32_t out[kAxes]) const {
@@ -278,10 +294,13 @@ void StepGen::pushed_position(int32_t out[kAxes]) const {
         for (uint8_t k = 0; k < 3; ++k) out[cv_.axes[k]] = cv_.w.pos[k];
         return;
     }
-    for (uint8_t j = 0; j < ln_.g.m; ++j) {
-        uint8_t a = ln_.g.axis[j];
-        int32_t p = static_cast<int32_t>(ln_.c.pos[j]);
-        out[a] += ((ln_.g.dirs >> a) & 1) ? -p : p;
+    const uint8_t* axis = ln_.g.axis;
+    const uint32_t* pos = ln_.c.pos;
+    const uint8_t dirs = ln_.g.dirs;
+    for (uint8_t j = ln_.g.m; j; --j) {
+        uint8_t a = *axis++;
+        int32_t p = static_cast<int32_t>(*pos++);
+        out[a] += ((dirs >> a) & 1) ? -p : p;
     }
 }
 
@@ -302,7 +321,8 @@ void StepGen::abort() {
 
 uint32_t StepGen::queued_cycles(const RunQueue& q) {
     horizon_full(q);
-    return static_cast<uint32_t>(queued_) << 10;
+    // queued_ < 16 x 255 < 2^14: << 2 in 16 bits, then << 8 as a byte move
+    return static_cast<uint32_t>(static_cast<uint16_t>(queued_ << 2)) << 8;
 }
 
 bool StepGen::horizon_full(const RunQueue& q) {
@@ -332,25 +352,30 @@ void StepGen::push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
 }
 
 void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8) {
-    uint32_t period = period_q8 > 0xFFFFFF7Ful ? 0xFFFFFFul : (period_q8 + 128) >> 8;
+    // Rounded to cycles, at most kMaxPeriodCycles (compared before rounding: no overflow).
+    static_assert(kMaxPeriodCycles < 1ul << 24, "kMaxPeriodCycles << 8 fits 32 bits");
+    uint32_t period =
+        period_q8 >= kMaxPeriodCycles << 8 ? kMaxPeriodCycles : (period_q8 + 128) >> 8;
     if (period < min_period_) {
         period = min_period_;
 #if LL_STATS
         ++stats.clamped;
 #endif
     }
-    if (period > kMaxPeriodCycles) period = kMaxPeriodCycles;
     if (period <= 0xFFFF) {
-        // >> 10 as a byte move and two shifts (avr-gcc 5.4 makes a 10-turn loop of it)
-        uint32_t units = ((count == 1 ? period : period * count) >> 8) >> 2; // < 2^14
-        push(q, steps, dirs, count, static_cast<uint16_t>(period),
-             units > 255 ? 255 : static_cast<uint8_t>(units));
+        const uint16_t p16 = static_cast<uint16_t>(period);
+        // 16 x 8 bits < 2^24; >> 10 as a byte move (into 16 bits) and two shifts: avr-gcc 5.4
+        // makes a 10-turn loop of a 32-bit >> 10
+        const uint16_t units =
+            static_cast<uint16_t>((static_cast<uint32_t>(p16) * count) >> 8) >> 2;
+        push(q, steps, dirs, count, p16, units > 255 ? 255 : static_cast<uint8_t>(units));
     } else {
         // Below 245 steps/s: each event is preceded by idle waits (steps == 0) so that every
         // compare value fits the 16-bit timer without changing its prescaler.
-        uint32_t parts = (period + kIdleChunk - 1) / kIdleChunk;
-        uint16_t each = static_cast<uint16_t>(period / parts);
-        uint16_t last = static_cast<uint16_t>(period - (parts - 1) * each);
+        const uint16_t parts = static_cast<uint16_t>(div32_16(period + kIdleChunk - 1, kIdleChunk));
+        const uint16_t each = static_cast<uint16_t>(div32_16(period, parts));
+        const uint16_t last =
+            static_cast<uint16_t>(period - static_cast<uint32_t>(parts - 1u) * each);
         for (uint8_t i = 0; i < count; ++i) {
             push(q, 0, dirs, static_cast<uint8_t>(parts - 1), each, 255);
             push(q, steps, dirs, 1, last, 63);
@@ -358,27 +383,24 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
     }
 }
 
-bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
+uint32_t StepGen::delta_at(uint32_t x2) {
     if (cruising_ && !holding_) {
         a_last_ = prof_.a_cruise; // profile_a(x2) == a_cruise: no evaluation
-        delta = prof_.cruise;
-        return true;
+        return prof_.cruise;
     }
+    x2 -= 2 * origin_;
     uint32_t a = profile_a(prof_, x2);
     if (holding_) {
         uint32_t dec = shl_sat(x2 - x2_hold_, static_cast<uint8_t>(prof_.log_s - 1));
         if (dec >= a_hold_) {
             stopped_ = true; // the speed reaches zero before this point
-            return false;
+            return 0;
         }
         uint32_t ah = a_hold_ - dec;
         if (ah < a) a = ah;
     }
     a_last_ = a;
-    if (a == prof_.a_cruise && !holding_) {
-        delta = prof_.cruise;
-        return true;
-    }
+    if (a == prof_.a_cruise && !holding_) return prof_.cruise;
     bool changed = !root_valid_;
     if (!root_valid_) {
         root_.reset(a);
@@ -392,14 +414,17 @@ bool StepGen::delta_at(uint32_t x2, uint32_t& delta) {
         ++stats.divisions;
 #endif
     }
-    delta = delta_root_;
+    uint32_t delta = delta_root_;
     if (a <= prof_.a_cruise && delta < prof_.cruise) delta = prof_.cruise;
-    return true;
+    return delta;
 }
 
-uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest) {
+__attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t k) {
     uint8_t next = 1;
-    if (longest <= 0xFFFF00ul) {
+    // A tick lasting kSegmentCycles already makes a one-tick segment, whatever the longest
+    // period: its product is only needed below that (and never for k = 0: delta itself).
+    if (delta < static_cast<uint32_t>(kSegmentCycles) << 8 &&
+        (k == 0 || mul_shr(delta, k, 20) <= 0xFFFF00ul)) {
         uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8; // / next: a shift
         while (next < kMaxSegmentTicks && delta < target) {
             next = static_cast<uint8_t>(next << 1);
@@ -426,8 +451,8 @@ void StepGen::fill_line(RunQueue& q) {
         if (horizon_full(q)) break;
         uint32_t left = ln_.g.dist[0] - ln_.c.x1;
         uint8_t len = left < seg_len_ ? static_cast<uint8_t>(left) : seg_len_;
-        uint32_t delta;
-        if (!delta_at(2 * (ln_.c.x1 - origin_) + len, delta)) break; // segment midpoint
+        const uint32_t delta = delta_at(2 * ln_.c.x1 + len); // segment midpoint
+        if (stopped_) break;
         uint8_t e[kAxes];
         line_advance(ln_.g, ln_.c, len, e);
         MicroRun runs[kAxes];
@@ -443,47 +468,38 @@ void StepGen::fill_line(RunQueue& q) {
         const bool tracked = ln_.g.m > 2;
         int32_t corr = 0; // per tick, Q20 of the mean K (1.0): the next ticks last (1 - corr)
         if (tracked) {
-            uint8_t sh = 0; // spread over the segment length in force (not a short last one)
-            while ((2u << sh) <= seg_len_) ++sh;
             const int32_t band = 1l << 19;
-            int32_t over = ln_.k_err > band ? ln_.k_err - band : 0;
-            if (ln_.k_err < -band) over = ln_.k_err + band;
-            corr = over >> sh;                      // arithmetic shift
+            const int32_t err = ln_.k_err;
+            corr = err > band ? err - band : 0;
+            if (err < -band) corr = err + band;
+            // spread over the segment length in force (a power of two; not a short last one)
+            for (uint8_t l = seg_len_; l > 1; l = static_cast<uint8_t>(l >> 1)) corr >>= 1;
             if (corr > (1l << 18)) corr = 1l << 18; // at most a quarter: no jolt
             if (corr < -(1l << 18)) corr = -(1l << 18);
         }
-        uint32_t d = delta;
-        if (corr > 0) d -= mul_shr(delta, static_cast<uint32_t>(corr), 20);
-        if (corr < 0) d += mul_shr(delta, static_cast<uint32_t>(-corr), 20);
+        const uint32_t d = corr ? less(delta, corr) : delta;
         // At cruise (most segments of a job) the periods are the move's constants.
         const bool at_cruise = delta == prof_.cruise;
         const bool constants = at_cruise && corr == 0;
         uint32_t sum = 0;
-        for (uint8_t i = 0; i < n; ++i) {
-            uint8_t idx = static_cast<uint8_t>(runs[i].set >> 1);
-            if (tracked) sum += runs[i].count * ln_.k[idx];
-            emit(q, ln_.mask[idx], ln_.g.dirs, runs[i].count,
+        for (const MicroRun* r = runs; n; --n, ++r) {
+            const uint8_t idx = static_cast<uint8_t>(r->set >> 1);
+            const uint8_t count = r->count;
+            if (tracked) sum += count * ln_.k[idx];
+            emit(q, ln_.mask[idx], ln_.g.dirs, count,
                  constants ? ln_.cruise_period[idx] : mul_shr(d, ln_.k[idx], 20));
         }
         if (tracked) {
             // What this segment took, in K units of the uncorrected Delta_1: sum x (1 - corr).
-            int32_t took = static_cast<int32_t>(sum);
-            if (corr > 0)
-                took -= static_cast<int32_t>(mul_shr(sum, static_cast<uint32_t>(corr), 20));
-            if (corr < 0)
-                took += static_cast<int32_t>(mul_shr(sum, static_cast<uint32_t>(-corr), 20));
-            ln_.k_err += took - (static_cast<int32_t>(len) << 20);
+            int32_t took = static_cast<int32_t>(less(sum, corr));
+            // len << 20 as (len << 4) << 16: a byte move, not twenty shifts
+            ln_.k_err += took - static_cast<int32_t>(static_cast<uint32_t>(len << 4) << 16);
         }
 #if LL_STATS
         ++stats.segments;
 #endif
-        // A tick lasting kSegmentCycles already makes a one-tick segment, whatever the longest
-        // period: its product is only needed below that.
-        seg_len_ = at_cruise ? ln_.cruise_seg
-                   : delta >= static_cast<uint32_t>(kSegmentCycles) << 8
-                       ? 1
-                       : next_segment(delta, mul_shr(delta, ln_.kmax, 20));
-        if (ln_.c.x1 == ln_.g.dist[0]) finish_move();
+        seg_len_ = at_cruise ? ln_.cruise_seg : next_segment(delta, ln_.kmax);
+        if (left == len) finish_move(); // the line's end reached
     }
 }
 
@@ -497,14 +513,16 @@ void StepGen::fill_curve(RunQueue& q) {
         int32_t d[3];
         uint16_t left = cv_.w.peek(d);
         Num sum{};
-        for (uint8_t k = 0; k < 3; ++k) {
-            if (!(cv_.chord & (1u << k))) continue;
+        uint8_t chord = cv_.chord;
+        for (uint8_t k = 0; k < 3; ++k, chord >>= 1) {
+            if (!(chord & 1)) continue;
             Num v(abs32(d[k]));
             v.mul(v).mul(lengths_->inv2[cv_.axes[k]]);
             sum.add(v);
         }
-        // mm over 2^16 -> µm x 256
-        uint32_t chord_q8 = sum.sqrt().mul(256000).shift(-16).u32();
+        // mm over 2^16 -> µm x 256: x 256000 / 2^16 = 0xFA000000 x 2^-30 (mul() would take
+        // 256000 as 0xFA000000 x 2^-14, then the shift)
+        uint32_t chord_q8 = sum.sqrt().mulc(0xFA000000ul, -30).u32();
         if (chord_q8 == 0) chord_q8 = 1;
         // The segment's length depends on the speed only, never on how full the queue is (the
         // chip and the host model must cut the same segments): wait for room for all of it.
@@ -515,22 +533,26 @@ void StepGen::fill_curve(RunQueue& q) {
         if (left != 0 && left < n) n = static_cast<uint8_t>(left);
         if (q.free_slots() < 2 * n + 2) break;
         uint32_t mid = cv_.x_q8 + chord_q8 * n / 2;
-        uint32_t delta;
-        if (!delta_at(2 * ((mid >> 8) - origin_), delta)) break;
+        const uint32_t delta = delta_at(2 * (mid >> 8));
+        if (stopped_) break;
         // Delta (cycles x 256 per µm) x chord (µm x 256) / 256.
         uint32_t period_q8 = mul_shr(delta, chord_q8, 8);
         // Samples of the same axes and directions make one run.
+        // (u, v, w) bits to machine-axis bits: axis (k - plane) mod 3 (begin_curve) is a
+        // rotation of the three bits by plane = 2 - axes[2] to the right.
+        const uint8_t plane = static_cast<uint8_t>(2 - cv_.axes[2]);
         uint8_t run_steps = 0, run_dirs = 0, run_count = 0;
         uint8_t i = 0;
         for (; i < n; ++i) {
             uint8_t moved, neg;
             if (!cv_.w.next(moved, neg)) break;
-            uint8_t steps = 0, dirs = 0;
-            for (uint8_t k = 0; k < 3; ++k, moved >>= 1, neg >>= 1) {
-                uint8_t bit = static_cast<uint8_t>(1u << cv_.axes[k]);
-                if (moved & 1) steps = static_cast<uint8_t>(steps | bit);
-                if (neg & 1) dirs = static_cast<uint8_t>(dirs | bit);
+            uint8_t steps = static_cast<uint8_t>(moved * 9u), dirs = static_cast<uint8_t>(neg * 9u);
+            for (uint8_t p = plane; p; --p) {
+                steps = static_cast<uint8_t>(steps >> 1);
+                dirs = static_cast<uint8_t>(dirs >> 1);
             }
+            steps &= 7;
+            dirs &= 7;
             if (run_count != 0 && (steps != run_steps || (steps && dirs != run_dirs))) {
                 emit(q, run_steps, run_dirs, run_count, period_q8);
                 run_count = 0;
@@ -547,20 +569,34 @@ void StepGen::fill_curve(RunQueue& q) {
         ++stats.segments;
 #endif
         // A curve segment costs a chord (a square root) on top of its samples: 8x the line
-        // segment duration keeps that cost to a fraction of the time the samples take.
-        seg_len_ = next_segment(period_q8 < 8 ? 1 : period_q8 >> 3, period_q8);
+        // segment duration keeps that cost to a fraction of the time the samples take (one
+        // sample when it needs idle waits).
+        seg_len_ = period_q8 > 0xFFFF00ul ? 1 : next_segment(period_q8 >> 3, 0);
         if (cv_.w.done()) finish_move();
     }
 }
 
+uint32_t StepGen::ref_len() const {
+    return curve_ ? cv_.ref_um : ln_.g.dist[0];
+}
+
+uint32_t StepGen::progress() const {
+    return curve_ ? (cv_.x_q8 >> 8) : ln_.c.x1;
+}
+
+uint32_t StepGen::x2_now() const {
+    return 2 * (progress() - origin_);
+}
+
 uint8_t StepGen::fill(RunQueue& q) {
-    uint8_t pushed_before = q.used();
+    // Runs pushed: how far the tail moved (the interrupt may move the head meanwhile).
+    const uint8_t tail = q.tail;
     if (curve_) {
         fill_curve(q);
     } else {
         fill_line(q);
     }
-    return static_cast<uint8_t>(q.used() - pushed_before);
+    return static_cast<uint8_t>((q.tail - tail) & (kRunQueueSize - 1));
 }
 
 } // namespace ll

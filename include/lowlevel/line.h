@@ -35,8 +35,8 @@ struct LineGeometry {
     uint32_t slope[kAxes];
 };
 
-/// Sets up the line from the per-axis deltas (ticks). Returns false for a zero-length line or
-/// one longer than kMaxLineTicks on its reference axis.
+/// Sets up the line from the per-axis deltas (ticks). Returns false (with m = 0) for a
+/// zero-length line or one longer than kMaxLineTicks on its reference axis.
 bool line_setup(LineGeometry& g, const int32_t delta[kAxes]);
 
 /// Macro position along a line (seed §2.1), in ticks travelled per sorted position.

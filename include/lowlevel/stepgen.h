@@ -139,29 +139,33 @@ class StepGen {
     bool start_profile(const MoveSpec& spec, uint32_t ticks);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
-    /// Sets x2_decel_ and cruising_ from prof_.
-    void mark_profile();
+    /// a_of(v2), A_cruise without a product when v2 is the nominal speed (set A_cruise first).
+    uint32_t a_near(uint32_t v2) const;
+    /// Sets prof_.a_exit for the exit speed v_exit2 (at most A_cruise), then x2_decel_ and
+    /// cruising_ from prof_.
+    void set_a_exit(uint32_t v_exit2);
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
     /// queued_cycles(q) >= kHorizonCycles.
     bool horizon_full(const RunQueue& q);
     /// Queues one run and counts its duration (1024-cycle units) in the horizon.
     void push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint16_t period,
               uint8_t units);
-    /// Delta_1 (cycles x 256 per reference unit) at half-unit position x2; false when a hold
-    /// brings the speed to zero before x2.
-    bool delta_at(uint32_t x2, uint32_t& delta);
+    /// Delta_1 (cycles x 256 per reference unit) at half-unit position x2 of the move (origin_
+    /// not taken out); sets stopped_ when a hold brings the speed to zero before x2.
+    uint32_t delta_at(uint32_t x2);
     /// Length of the next segment, reference units: the shortest power of two lasting
-    /// kSegmentCycles at `delta`, 1 when `longest` (the largest period, x 256) needs idle waits.
-    static uint8_t next_segment(uint32_t delta, uint32_t longest);
+    /// kSegmentCycles at `delta`, 1 when the longest period (delta x k, k the largest K in Q20;
+    /// cycles x 256; k = 0: delta itself) needs idle waits.
+    static uint8_t next_segment(uint32_t delta, uint32_t k);
     void fill_line(RunQueue& q);
     void fill_curve(RunQueue& q);
     void finish_move();
-    uint32_t ref_len() const {
-        return curve_ ? cv_.ref_um : ln_.g.dist[0];
-    }
-    uint32_t progress() const {
-        return curve_ ? (cv_.x_q8 >> 8) : ln_.c.x1;
-    }
+    /// The move's reference length and the reference ticks produced (out of line: one call is
+    /// smaller than the test of curve_ and the far member reads).
+    uint32_t ref_len() const;
+    uint32_t progress() const;
+    /// Where the last segment ended, half ticks from origin_.
+    uint32_t x2_now() const;
 
     // Most used first: the ATmega328P addresses the first 64 bytes of an object directly.
     bool active_;
@@ -170,34 +174,35 @@ class StepGen {
     bool have_handover_;
     bool root_valid_;
     bool lens_valid_; ///< ln_.lens holds step lengths (no curve ran since, same settings)
-    bool cruising_;   ///< the profile is at cruise from end to end (mark_profile())
+    bool cruising_;   ///< the profile is at cruise from end to end (set_a_exit())
     uint8_t seg_len_;
     uint8_t seen_head_;
     uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
     uint16_t min_period_;
-    uint32_t origin_;     ///< reference tick where the profile starts (moves after a resume)
-    uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
-    uint32_t a_last_;     ///< A of the last segment
+    // The move being produced: a line or a curve, never both, so they share their memory.
+    const CurveParams* curve_;
+    uint32_t origin_; ///< reference tick where the profile starts (moves after a resume)
+    uint32_t a_last_; ///< A of the last segment
+    Profile prof_;
+    SqrtTracker root_;
     uint32_t delta_root_; ///< d_num / R for the current R
+    uint32_t v_exit2_;    ///< exit speed squared, (mm/min)^2 (MoveSpec)
+    uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
     // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
     uint32_t a_hold_;
     uint32_t x2_hold_;
     uint32_t handover_v2_;
-    Profile prof_;
-    SqrtTracker root_;
     Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
     // What remains needed of the MoveSpec after begin().
-    uint32_t len_q8_, feed_, v_nominal2_, v_exit2_;
+    uint32_t len_q8_, feed_, v_nominal2_;
     Num dv2_; ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
-    // The move being produced: a line or a curve, never both, so they share their memory.
-    const CurveParams* curve_;
     struct LineState {
-        LineGeometry g;
-        LineCursor c;
         uint32_t kmax; ///< largest K of the move
         int32_t k_err; ///< K-time emitted beyond len x Delta_1 so far, Q20 (see fill_line)
+        LineGeometry g;
+        LineCursor c;
         uint32_t k[1u << (kAxes - 1)];   ///< K table, Q20 (see k())
         uint8_t mask[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
         // Step length of each sorted set (restricted to the regulated group), kept from one
@@ -208,11 +213,11 @@ class StepGen {
         uint8_t cruise_seg;                        ///< segment length at cruise
     };
     struct CurveState {
-        CurveWalker w;
         uint32_t ref_um; ///< its length, µm (the profile's reference length)
         uint32_t x_q8;   ///< distance travelled, µm x 256
         uint8_t axes[3]; ///< machine axes u, v, w
         uint8_t chord;   ///< bits (u = 1, v = 2, w = 4) of the axes the path is timed along
+        CurveWalker w;
     };
     union {
         LineState ln_;
