@@ -22,8 +22,10 @@
 namespace ll {
 
 /// Minimum duration of a macro segment, CPU cycles. The measured cost of producing one segment
-/// on the ATmega328P (docs/motion.md) must stay well below it.
-constexpr uint16_t kSegmentCycles = 2048;
+/// on the ATmega328P (docs/motion.md: 2,514 to 3,558 cycles, plus 54 per step for the step
+/// interrupt) must stay below it. It was 2048, below that cost: the run queue ran dry whenever
+/// the segments were that short (FirmwarePulses at the 264-cycle minimum period, 22 times).
+constexpr uint16_t kSegmentCycles = 4096;
 /// How far ahead of the step interrupt the generator commits motion, CPU cycles (4 ms). Motion
 /// not yet produced can still be replanned (a later move raising this one's exit speed, a feed
 /// hold), so the generator stays this close behind the interrupt; the main loop must come back
