@@ -26,7 +26,6 @@ constexpr uint16_t kTccr1b = 0x81; // data-space address of TCCR1B
 constexpr uint8_t kPaint = 0xA5;
 constexpr uint8_t kClockSelect = 0x07; // CS12..CS10: non-zero while Timer1 counts
 constexpr uint64_t kLineTimeout = 200ull * 16000;
-constexpr uint64_t kJobLimit = 5ull * 16000000; // longest job (1.5 s) with room, simulated
 
 using Clock = std::chrono::steady_clock;
 
@@ -202,7 +201,7 @@ Trace run_on_chip(Sim& sim, const Job& job) {
     sim.send("~");
     const int poll =
         job.status_every_ms == 0 ? 0 : sim.send_every('?', c0 + ms(1), ms(job.status_every_ms));
-    const uint64_t limit = c0 + kJobLimit;
+    const uint64_t limit = c0 + ms(job.limit_ms);
     // Run until the timer has stopped and stayed stopped for kTail.
     sim.run_until([&] { return sim.peek(running) != 0; }, ms(50));
     for (;;) {
@@ -264,7 +263,7 @@ Trace run_on_model(const Job& job) {
     }
     const uint64_t c0 = host::now();
     d.send("~");
-    const uint64_t limit = c0 + kJobLimit;
+    const uint64_t limit = c0 + ms(job.limit_ms);
     uint64_t quiet_since = host::now();
     for (;;) {
         const bool was = host::timer_running();

@@ -50,6 +50,10 @@ struct Job {
     /// reports take the receive interrupt and the main loop's critical sections; the model's
     /// edges do not depend on them.
     uint32_t status_every_ms = 0;
+    /// Simulated time the job may take from `~` to its last step, ms (both sides): a job that
+    /// has not ended by then fails. The timing jobs take up to 1.5 s; the speed-group jobs run
+    /// 9 and 15 s at the rates they check.
+    uint32_t limit_ms = 5000;
 };
 
 /// What one side did with a job.

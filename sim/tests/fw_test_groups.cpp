@@ -36,6 +36,7 @@ Trace run(const std::vector<std::string>& extra, const std::string& line) {
     job.settings = kSettings;
     job.settings.insert(job.settings.end(), extra.begin(), extra.end());
     job.lines = {line};
+    job.limit_ms = 20000; // G1 A90 F600 takes 9 s, G1 X10 A900 at A's 3600 deg/min 15 s
     Trace t = run_on_chip(job);
     EXPECT_TRUE(t.errors.empty()) << t.errors.front();
     return t;
