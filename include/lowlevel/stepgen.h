@@ -3,9 +3,9 @@
 // a time, from the main loop, while the interrupt executes the runs queued before.
 //
 // Per macro segment (docs/motion.md, "Compute windows"):
-//   1. the segment length L (reference-axis ticks, a power of two <= 16) is the smallest that
-//      makes the segment last at least kSegmentCycles at the current speed, so that producing
-//      the next segment always takes less time than executing this one;
+//   1. the segment length L (reference-axis ticks, a power of two <= kMaxSegmentTicks) is the
+//      smallest that makes the segment last at least kSegmentCycles at the current speed, so
+//      that producing the next segment always takes less time than executing this one;
 //   2. the speed at the segment's midpoint comes from the sqrt-free profile (profile.h);
 //   3. the next macro position comes from the line (line.h), the runs from the micro-stepper
 //      (microstep.h), and each run's period is K_P * Delta_1 (seed §5) from the move's K table.
@@ -154,7 +154,9 @@ class StepGen {
     bool delta_at(uint32_t x2, uint32_t& delta);
     /// Length of the next segment, reference units: the shortest power of two lasting
     /// kSegmentCycles at `delta`, 1 when `longest` (the largest period, x 256) needs idle waits.
-    static uint8_t next_segment(uint32_t delta, uint32_t longest);
+    /// At most 16, or kMaxSegmentTicks where the speed changes little over that many ticks:
+    /// `a` (the profile's A there; 0: never) at least s (4 longest + 64) (docs/verification.md).
+    uint8_t next_segment(uint32_t delta, uint32_t longest, uint32_t a) const;
     void fill_line(RunQueue& q);
     void fill_curve(RunQueue& q);
     void finish_move();
