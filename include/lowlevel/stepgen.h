@@ -21,11 +21,14 @@
 
 namespace ll {
 
-/// Minimum duration of a macro segment, CPU cycles. The measured cost of producing one segment
-/// on the ATmega328P (docs/motion.md: 2,514 to 3,558 cycles, plus 54 per step for the step
-/// interrupt) must stay below it. It was 2048, below that cost: the run queue ran dry whenever
-/// the segments were that short (FirmwarePulses at the 264-cycle minimum period, 22 times).
-constexpr uint16_t kSegmentCycles = 4096;
+/// Minimum duration of a macro segment, CPU cycles. Producing one segment costs about 2,400
+/// to 3,500 cycles on the chip (docs/motion.md; lowlevel.elf in simavr), plus 54 per step for
+/// the step interrupt, and the segments must leave room for the per-line work too: parsing
+/// and planning a G1 line and starting its move took about 35,000 cycles in the 0.5 mm, 100
+/// mm/s stream of FirmwareRunQueue, 44 % of the 80,000 cycles such a line lasts. 2048 (the
+/// first value) and 4096 were below that budget and the run queue ran dry mid-move (22
+/// times at the 264-cycle minimum period with 2048; 57 times in that stream with 4096).
+constexpr uint16_t kSegmentCycles = 6144;
 /// How far ahead of the step interrupt the generator commits motion, CPU cycles (4 ms). Motion
 /// not yet produced can still be replanned (a later move raising this one's exit speed, a feed
 /// hold), so the generator stays this close behind the interrupt; the main loop must come back
