@@ -154,12 +154,12 @@ ISR(TIMER1_COMPA_vect, ISR_NAKED) {
         "rjmp 2b\n\t"
         "ldi  r24, 1 << %[ocf1b]\n\t"
         "out  %[tifr1], r24\n\t"
-        // 5 cycles: on silicon COMPB's first write comes 10 cycles after its flag (4 response,
-        // 3 jmp, push, in); this one comes 10..12 cycles after it (sbis sees the flag 0..2
-        // cycles late, skip 2, ldi, out, padding 5, in): never earlier than COMPB's.
+        // 4 cycles: on silicon COMPB's first write comes 9 cycles after its flag (4 response,
+        // 2 for the vector's rjmp, push, in: step_timing.h); this one comes 9..11 cycles after
+        // it (sbis sees the flag 0..2 cycles late, skip 2, ldi, out, padding 4, in): never
+        // earlier than COMPB's. (5 until the table's jmp became an rjmp: 1 cycle late.)
         "rjmp .+0\n\t"
         "rjmp .+0\n\t"
-        "nop\n\t"
         "in   r24, %[ed_reg]\n\t"
         "out  %[pind], r24\n\t" // pulse end (+ direction change), X/Y/Z
         "lds  r24, %[end_b]\n\t"
