@@ -406,7 +406,7 @@ uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest, uint32_t a) cons
             next = static_cast<uint8_t>(next << 1);
             target >>= 1;
         }
-        // Above 62.5 k steps/s 16 ticks last less than kSegmentCycles, and a segment whose
+        // Above 41.7 k steps/s 16 ticks last less than kSegmentCycles, and a segment whose
         // speed changes costs about 3,000 cycles to produce, more than 16 ticks leave at 152
         // cycles a step (docs/verification.md): 32 ticks, but only where that keeps the speed
         // within the tolerance stated for 16 (docs/motion.md, "Speed accuracy"). A tick u away
