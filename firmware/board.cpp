@@ -1,4 +1,5 @@
-// Pin directions, limit inputs and critical sections (board.h has the map).
+// Pin directions and limit inputs (board.h has the map; the critical sections are inline in
+// lowlevel/hal.h).
 #include <avr/io.h>
 
 #include "board.h"
@@ -30,16 +31,7 @@ uint8_t limits() {
     return g_settings.limit_invert ? pins : static_cast<uint8_t>(pins ^ 0x07);
 }
 
-uint8_t irq_save() {
-    uint8_t s = SREG;
-    asm volatile("cli" ::: "memory");
-    return s;
-}
-
-void irq_restore(uint8_t state) {
-    asm volatile("" ::: "memory");
-    SREG = state;
-}
+// irq_save() / irq_restore(): inline in hal.h.
 
 } // namespace hal
 } // namespace ll

@@ -95,57 +95,55 @@ uint8_t s_enable_invert;        // $4
 // 30 operands; a naked function holds nothing else, so they assemble back to back (local labels
 // cross from one to the other).
 ISR(TIMER1_COMPA_vect, ISR_NAKED) {
-    asm volatile(
-        "push r24\n\t"
-        "in   r24, %[sd_reg]\n\t"
-        "out  %[pind], r24\n\t" // step edge, X/Y/Z: fixed offset, before any branch
-        "lds  r24, %[step_b]\n\t"
-        "out  %[pinb], r24\n\t" // step edge, A
-        "in   r24, __SREG__\n\t"
-        "push r24\n\t"
-        "lds  r24, %[exec]+0\n\t" // g_exec.remaining
-        "dec  r24\n\t"
-        "sts  %[exec]+0, r24\n\t"
-        "breq 1f\n\t"
-        "0:\n\t"
-        "pop  r24\n\t"
-        "out  __SREG__, r24\n\t"
-        "pop  r24\n\t"
-        "reti\n\t"
-        // The run's last event. Decide now, as the model does at the event.
-        "1:\n\t"
-        "push r25\n\t"
-        "push r30\n\t"
-        "push r31\n\t"
-        "lds  r30, %[head]\n\t"
-        "lds  r24, %[head]+1\n\t" // tail
-        "set\n\t"                 // T = 1: the queue is empty, stop after this pulse
-        "cp   r30, r24\n\t"
-        "breq 2f\n\t"
-        "clt\n\t" // T = 0: load the head run after this pulse
-        "mov  r24, r30\n\t"
-        "lsl  r30\n\t"
-        "lsl  r30\n\t"
-        "add  r30, r24\n\t"
-        "ldi  r31, 0\n\t"
-        "subi r30, lo8(-(%[buf]))\n\t"
-        "sbci r31, hi8(-(%[buf]))\n\t" // Z = &g_runs.buf[head]
-        "inc  r24\n\t"
-        "andi r24, %[qmask]\n\t"
-        "sts  %[head], r24\n\t"   // pop now: the main loop cannot run before this handler ends
-        "ldd  r25, Z+1\n\t"       // its dirs
-        "lds  r24, %[exec]+2\n\t" // g_exec.dirs: the pins' current directions
-        "sts  %[exec]+2, r25\n\t"
-        "eor  r25, r24\n\t" // axes whose direction pin toggles at the pulse end
-        "in   r24, %[ed_reg]\n\t" LL_OR_AXES(dd) "out  %[ed_reg], r24\n\t"
-                                                 "lds  r24, %[end_b]\n\t" LL_OR_AXES(
-                                                     db) "sts  %[end_b], r24\n\t"
-        :
-        : [pind] "I"(_SFR_IO_ADDR(PIND)), [pinb] "I"(_SFR_IO_ADDR(PINB)),
-          [sd_reg] "I"(_SFR_IO_ADDR(GPIOR1)), [ed_reg] "I"(_SFR_IO_ADDR(GPIOR2)),
-          [step_b] "i"(&ll::s_step_b), [end_b] "i"(&ll::s_end_b), [exec] "i"(&ll::g_exec),
-          [head] "i"(&ll::g_runs.head), [buf] "i"(&ll::g_runs.buf[0]),
-          [qmask] "M"(ll::kRunQueueSize - 1), LL_MASK_OPERANDS(d, dir_bit));
+    asm volatile("push r24\n\t"
+                 "in   r24, %[sd_reg]\n\t"
+                 "out  %[pind], r24\n\t" // step edge, X/Y/Z: fixed offset, before any branch
+                 "lds  r24, %[step_b]\n\t"
+                 "out  %[pinb], r24\n\t" // step edge, A
+                 "in   r24, __SREG__\n\t"
+                 "push r24\n\t"
+                 "lds  r24, %[exec]+0\n\t" // g_exec.remaining
+                 "dec  r24\n\t"
+                 "sts  %[exec]+0, r24\n\t"
+                 "breq 1f\n\t"
+                 "0:\n\t"
+                 "pop  r24\n\t"
+                 "out  __SREG__, r24\n\t"
+                 "pop  r24\n\t"
+                 "reti\n\t"
+                 // The run's last event. Decide now, as the model does at the event.
+                 "1:\n\t"
+                 "push r25\n\t"
+                 "push r30\n\t"
+                 "push r31\n\t"
+                 "lds  r30, %[head]\n\t"
+                 "lds  r24, %[head]+1\n\t" // tail
+                 "set\n\t"                 // T = 1: the queue is empty, stop after this pulse
+                 "cp   r30, r24\n\t"
+                 "breq 2f\n\t"
+                 "clt\n\t" // T = 0: load the head run after this pulse
+                 "mov  r24, r30\n\t"
+                 "lsl  r30\n\t"
+                 "lsl  r30\n\t"
+                 "add  r30, r24\n\t"
+                 "ldi  r31, 0\n\t"
+                 "subi r30, lo8(-(%[buf]))\n\t"
+                 "sbci r31, hi8(-(%[buf]))\n\t" // Z = &g_runs.buf[head]
+                 // Only what the pulse end needs comes before it (at $0 = 3 us this work
+                 // outlasts the pulse and delays its end): the run is popped after it.
+                 "ldd  r25, Z+1\n\t"       // its dirs
+                 "lds  r24, %[exec]+2\n\t" // g_exec.dirs: the pins' current directions
+                 "sts  %[exec]+2, r25\n\t"
+                 "eor  r25, r24\n\t" // axes whose direction pin toggles at the pulse end
+                 "in   r24, %[ed_reg]\n\t" LL_OR_AXES(dd) "out  %[ed_reg], r24\n\t"
+                                                          "lds  r24, %[end_b]\n\t" LL_OR_AXES(
+                                                              db) "sts  %[end_b], r24\n\t"
+                 :
+                 : [pind] "I"(_SFR_IO_ADDR(PIND)), [pinb] "I"(_SFR_IO_ADDR(PINB)),
+                   [sd_reg] "I"(_SFR_IO_ADDR(GPIOR1)), [ed_reg] "I"(_SFR_IO_ADDR(GPIOR2)),
+                   [step_b] "i"(&ll::s_step_b), [end_b] "i"(&ll::s_end_b), [exec] "i"(&ll::g_exec),
+                   [head] "i"(&ll::g_runs.head), [buf] "i"(&ll::g_runs.buf[0]),
+                   LL_MASK_OPERANDS(d, dir_bit));
     asm volatile(
         // Wait for the instant COMPB would end the pulse (its flag), end it the same way, and
         // keep COMPB from running for this event.
@@ -154,18 +152,23 @@ ISR(TIMER1_COMPA_vect, ISR_NAKED) {
         "rjmp 2b\n\t"
         "ldi  r24, 1 << %[ocf1b]\n\t"
         "out  %[tifr1], r24\n\t"
-        // 5 cycles: on silicon COMPB's first write comes 10 cycles after its flag (4 response,
-        // 3 jmp, push, in); this one comes 10..12 cycles after it (sbis sees the flag 0..2
-        // cycles late, skip 2, ldi, out, padding 5, in): never earlier than COMPB's.
+        // 4 cycles: on silicon COMPB's first write comes 9 cycles after its flag (4 response,
+        // 2 for the vector's rjmp, push, in: step_timing.h); this one comes 9..11 cycles after
+        // it (sbis sees the flag 0..2 cycles late, skip 2, ldi, out, padding 4, in): never
+        // earlier than COMPB's. (5 until the table's jmp became an rjmp: 1 cycle late.)
         "rjmp .+0\n\t"
         "rjmp .+0\n\t"
-        "nop\n\t"
         "in   r24, %[ed_reg]\n\t"
         "out  %[pind], r24\n\t" // pulse end (+ direction change), X/Y/Z
         "lds  r24, %[end_b]\n\t"
         "out  %[pinb], r24\n\t" // pulse end (+ direction change), A
         "brts 3f\n\t"
-        // Load the run (Z still points at it): masks, count, period; then pop it.
+        // Pop the run (the main loop cannot run before this handler ends) and load it (Z still
+        // points at it): masks, count, period.
+        "lds  r24, %[head]\n\t"
+        "inc  r24\n\t"
+        "andi r24, %[qmask]\n\t"
+        "sts  %[head], r24\n\t"
         "ld   r25, Z\n\t" // steps
         "sts  %[exec]+1, r25\n\t"
         "ldi  r24, 0\n\t" LL_OR_AXES(
@@ -208,6 +211,7 @@ ISR(TIMER1_COMPA_vect, ISR_NAKED) {
         : [pind] "I"(_SFR_IO_ADDR(PIND)), [pinb] "I"(_SFR_IO_ADDR(PINB)),
           [sd_reg] "I"(_SFR_IO_ADDR(GPIOR1)), [ed_reg] "I"(_SFR_IO_ADDR(GPIOR2)),
           [step_b] "i"(&ll::s_step_b), [end_b] "i"(&ll::s_end_b), [exec] "i"(&ll::g_exec),
+          [head] "i"(&ll::g_runs.head), [qmask] "M"(ll::kRunQueueSize - 1),
           [tifr1] "I"(_SFR_IO_ADDR(TIFR1)), [ocf1b] "I"(OCF1B), [min_period] "i"(&ll::s_min_period),
           [ocr1a] "n"(_SFR_MEM_ADDR(OCR1AL)), [tccr1b] "n"(_SFR_MEM_ADDR(TCCR1B)),
           [tccr_stopped] "M"(ll::kTccr1bStopped), LL_MASK_OPERANDS(s, step_bit));

@@ -243,7 +243,8 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
         for (uint8_t sub = 0; sub < sets; ++sub) {
             ln_.cruise_period[sub] = mul_shr(prof_.cruise, ln_.k[sub], 20);
         }
-        ln_.cruise_seg = next_segment(prof_.cruise, ln_.kmax);
+        ln_.cruise_seg =
+            next_segment(prof_.cruise, mul_shr(prof_.cruise, ln_.kmax, 20), prof_.a_cruise);
     }
 }
 
@@ -419,17 +420,24 @@ uint32_t StepGen::delta_at(uint32_t x2) {
     return delta;
 }
 
-__attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t k) {
+__attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t longest,
+                                                        uint32_t a) const {
     uint8_t next = 1;
-    // A tick lasting kSegmentCycles already makes a one-tick segment, whatever the longest
-    // period: its product is only needed below that (and never for k = 0: delta itself).
-    if (delta < static_cast<uint32_t>(kSegmentCycles) << 8 &&
-        (k == 0 || mul_shr(delta, k, 20) <= 0xFFFF00ul)) {
+    if (longest <= 0xFFFF00ul) {
         uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8; // / next: a shift
-        while (next < kMaxSegmentTicks && delta < target) {
+        while (next < 16 && delta < target) {
             next = static_cast<uint8_t>(next << 1);
             target >>= 1;
         }
+        // Above 41.7 k steps/s 16 ticks last less than kSegmentCycles, and a segment whose
+        // speed changes costs about 3,000 cycles to produce, more than 16 ticks leave at 152
+        // cycles a step (docs/verification.md): 32 ticks, but only where that keeps the speed
+        // within the tolerance stated for 16 (docs/motion.md, "Speed accuracy"). A tick u away
+        // from the segment's midpoint runs off by u / (2 l) with l = A / s ticks from rest; 16
+        // ticks give 8 / l where 16-tick segments are allowed 4 / l, and 4 / l <= 1 / Delta
+        // (the allowance for whole cycles) once l >= 4 Delta; 64 ticks more cover how far A
+        // moves until the next segment.
+        if (delta < target && (a >> prof_.log_s) >= (longest >> 6) + 64) next = kMaxSegmentTicks;
     }
     return next;
 }
@@ -498,7 +506,12 @@ void StepGen::fill_line(RunQueue& q) {
 #if LL_STATS
         ++stats.segments;
 #endif
-        seg_len_ = at_cruise ? ln_.cruise_seg : next_segment(delta, ln_.kmax);
+        // A tick lasting kSegmentCycles already makes a one-tick segment, whatever the longest
+        // period: its product is only needed below that.
+        seg_len_ = at_cruise ? ln_.cruise_seg
+                   : delta >= static_cast<uint32_t>(kSegmentCycles) << 8
+                       ? 1
+                       : next_segment(delta, mul_shr(delta, ln_.kmax, 20), a_last_);
         if (left == len) finish_move(); // the line's end reached
     }
 }
@@ -571,7 +584,7 @@ void StepGen::fill_curve(RunQueue& q) {
         // A curve segment costs a chord (a square root) on top of its samples: 8x the line
         // segment duration keeps that cost to a fraction of the time the samples take (one
         // sample when it needs idle waits).
-        seg_len_ = period_q8 > 0xFFFF00ul ? 1 : next_segment(period_q8 >> 3, 0);
+        seg_len_ = next_segment(period_q8 >> 3, period_q8, 0);
         if (cv_.w.done()) finish_move();
     }
 }

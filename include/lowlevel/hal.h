@@ -66,8 +66,24 @@ uint8_t limits();
 // ---- critical sections ---------------------------------------------------------------------
 
 /// Saves the interrupt state and disables interrupts; restore with irq_restore().
+/// On the AVR both are inline (`in r, SREG; cli` ... `out SREG, r`): an out-of-line pair kept
+/// interrupts off for the `ret` of irq_save(), the `call` and the body of irq_restore() as
+/// well, up to 21 cycles in motion::position() (docs/verification.md), longer than
+/// step_timing::kPulseGuard. Inline, a section costs its body + 2 cycles. Plain inline asm, so
+/// the core still needs no chip header. The host fake (tools/host) defines them out of line.
+#if defined(__AVR__)
+inline uint8_t irq_save() {
+    uint8_t s;
+    asm volatile("in %0, __SREG__\n\tcli" : "=r"(s)::"memory");
+    return s;
+}
+inline void irq_restore(uint8_t state) {
+    asm volatile("out __SREG__, %0" ::"r"(state) : "memory");
+}
+#else
 uint8_t irq_save();
 void irq_restore(uint8_t state);
+#endif
 
 /// RAII critical section for short sections only (a few dozen cycles: every cycle spent here
 /// delays the step interrupt).

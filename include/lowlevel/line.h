@@ -17,13 +17,18 @@ namespace ll {
 /// S_j * L + P within 32 bits (k <= 26 with P >= 8 d_1) and a planned move's deltas within
 /// 24 bits. The G-code layer refuses longer moves (error:33).
 constexpr uint32_t kMaxLineTicks = (1ul << 23) - 1;
-/// Longest macro segment (reference-axis ticks between two computed positions).
-constexpr uint8_t kMaxSegmentTicks = 16;
+/// Longest macro segment (reference-axis ticks between two computed positions). 32, not 16:
+/// a segment costs about 3,000 cycles to produce while the speed changes (docs/motion.md), and
+/// at the 152-cycle minimum period 16 ticks last 2,432 cycles, 864 of them in the step
+/// interrupt, so an acceleration above about 70 k steps/s could not be produced in time.
+constexpr uint8_t kMaxSegmentTicks = 32;
 
 /// Fixed-point unit of slopes and fractions: 2^kLineUnit stands for one tick, whatever k (k <=
-/// 26 < kLineUnit), so that line_advance() shifts by a constant (a variable shift is a loop on
-/// the ATmega328P) and S_j * 16 + P stays within 32 bits.
-constexpr uint8_t kLineUnit = 27;
+/// 26 = kLineUnit), so that line_advance() shifts by a constant (a variable shift is a loop on
+/// the ATmega328P) and S_j * kMaxSegmentTicks + P stays within 32 bits.
+constexpr uint8_t kLineUnit = 26;
+static_assert((kMaxSegmentTicks + 1ull) << kLineUnit <= 1ull << 32,
+              "line_advance: S_j * len + frac within 32 bits");
 
 struct LineGeometry {
     uint8_t m;            ///< moving axes

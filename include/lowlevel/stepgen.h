@@ -3,9 +3,9 @@
 // a time, from the main loop, while the interrupt executes the runs queued before.
 //
 // Per macro segment (docs/motion.md, "Compute windows"):
-//   1. the segment length L (reference-axis ticks, a power of two <= 16) is the smallest that
-//      makes the segment last at least kSegmentCycles at the current speed, so that producing
-//      the next segment always takes less time than executing this one;
+//   1. the segment length L (reference-axis ticks, a power of two <= kMaxSegmentTicks) is the
+//      smallest that makes the segment last at least kSegmentCycles at the current speed, so
+//      that producing the next segment always takes less time than executing this one;
 //   2. the speed at the segment's midpoint comes from the sqrt-free profile (profile.h);
 //   3. the next macro position comes from the line (line.h), the runs from the micro-stepper
 //      (microstep.h), and each run's period is K_P * Delta_1 (seed §5) from the move's K table.
@@ -21,9 +21,14 @@
 
 namespace ll {
 
-/// Minimum duration of a macro segment, CPU cycles. The measured cost of producing one segment
-/// on the ATmega328P (docs/motion.md) must stay well below it.
-constexpr uint16_t kSegmentCycles = 2048;
+/// Minimum duration of a macro segment, CPU cycles. Producing one segment costs about 2,400
+/// to 3,500 cycles on the chip (docs/motion.md; lowlevel.elf in simavr), plus 54 per step for
+/// the step interrupt, and the segments must leave room for the per-line work too: parsing
+/// and planning a G1 line and starting its move took about 35,000 cycles in the 0.5 mm, 100
+/// mm/s stream of FirmwareRunQueue, 44 % of the 80,000 cycles such a line lasts. 2048 (the
+/// first value) and 4096 were below that budget and the run queue ran dry mid-move (22
+/// times at the 264-cycle minimum period with 2048; 57 times in that stream with 4096).
+constexpr uint16_t kSegmentCycles = 6144;
 /// How far ahead of the step interrupt the generator commits motion, CPU cycles (4 ms). Motion
 /// not yet produced can still be replanned (a later move raising this one's exit speed, a feed
 /// hold), so the generator stays this close behind the interrupt; the main loop must come back
@@ -154,9 +159,10 @@ class StepGen {
     /// not taken out); sets stopped_ when a hold brings the speed to zero before x2.
     uint32_t delta_at(uint32_t x2);
     /// Length of the next segment, reference units: the shortest power of two lasting
-    /// kSegmentCycles at `delta`, 1 when the longest period (delta x k, k the largest K in Q20;
-    /// cycles x 256; k = 0: delta itself) needs idle waits.
-    static uint8_t next_segment(uint32_t delta, uint32_t k);
+    /// kSegmentCycles at `delta`, 1 when `longest` (the largest period, x 256) needs idle waits.
+    /// At most 16, or kMaxSegmentTicks where the speed changes little over that many ticks:
+    /// `a` (the profile's A there; 0: never) at least s (4 longest + 64) (docs/verification.md).
+    uint8_t next_segment(uint32_t delta, uint32_t longest, uint32_t a) const;
     void fill_line(RunQueue& q);
     void fill_curve(RunQueue& q);
     void finish_move();

@@ -36,7 +36,7 @@ Trace run(const std::vector<std::string>& extra, const std::string& line) {
     job.settings = kSettings;
     job.settings.insert(job.settings.end(), extra.begin(), extra.end());
     job.lines = {line};
-    job.limit_s = 20; // A alone at 600 deg/min: 9 s; A at its 3600 deg/min for 900 deg: 15 s
+    job.limit_ms = 20000; // G1 A90 F600 takes 9 s, G1 X10 A900 at A's 3600 deg/min 15 s
     Trace t = run_on_chip(job);
     EXPECT_TRUE(t.errors.empty()) << t.errors.front();
     return t;

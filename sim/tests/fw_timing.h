@@ -89,8 +89,8 @@ inline void check_against_model(const char* label, const Job& job, const PinSett
                  static_cast<unsigned long long>(pc.max_pulse));
     char lead[64] = "none (already enabled)";
     if (cmp.enable_lead >= 0)
-        snprintf(lead, sizeof lead, "%lld cycles before the start",
-                 static_cast<long long>(cmp.enable_lead));
+        snprintf(lead, sizeof lead, "%lld cycles before the start (+%lld in interrupts)",
+                 static_cast<long long>(cmp.enable_lead), static_cast<long long>(cmp.enable_isr));
     if (pc.dir_changes != 0)
         snprintf(setup, sizeof setup, "%llu", static_cast<unsigned long long>(pc.min_dir_setup));
     printf("[ measured ] %s: %zu edges (%zu pulses); deviation, cycles: %s; pulse %s cycles (set "
