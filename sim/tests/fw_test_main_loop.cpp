@@ -47,9 +47,17 @@ MainLoop run_session() {
     uint32_t off_pc = 0;    // instruction that turned interrupts off
     uint32_t off_ret = 0;   // return address on top of the stack then
     bool off = false, reenabled = false;
+    // A frame is allocated by `out SPH` ... `out SPL` (with `out SREG` between, interrupts off):
+    // in between, SP reads as the new high byte with the old low byte, up to 255 bytes off. Such
+    // samples are not stack depths (no interrupt can come in between either).
+    bool sp_half = false;
     auto observe = [&](uint32_t pc_before, bool i_before) {
+        const uint8_t* f = sim.avr()->flash + pc_before;
+        const uint16_t op = static_cast<uint16_t>(f[0] | f[1] << 8);
+        if ((op & 0xFE0F) == 0xBE0E) sp_half = true;  // out 0x3e (SPH), rN
+        if ((op & 0xFE0F) == 0xBE0D) sp_half = false; // out 0x3d (SPL), rN
         const uint16_t sp = static_cast<uint16_t>(sim.peek(0x5D) | sim.peek(0x5E) << 8);
-        if (sp < r.min_sp) {
+        if (!sp_half && sp < r.min_sp) {
             r.min_sp = sp;
             r.min_sp_pc = sim.avr()->pc;
         }
