@@ -190,6 +190,7 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     if (ref_um == 0) ref_um = 1;
     cv_.ref_um = ref_um;
     cv_.x_q8 = 0;
+    cv_.chord_left = 0; // no chord yet (fill_curve)
     return start_profile(spec, ref_um);
 }
 
@@ -525,18 +526,26 @@ void StepGen::fill_curve(RunQueue& q) {
         // segment never crosses into the next piece, whose samples may be twice as long).
         int32_t d[3];
         uint16_t left = cv_.w.peek(d);
-        Num sum{};
-        uint8_t chord = cv_.chord;
-        for (uint8_t k = 0; k < 3; ++k, chord >>= 1) {
-            if (!(chord & 1)) continue;
-            Num v(abs32(d[k]));
-            v.mul(v).mul(lengths_->inv2[cv_.axes[k]]);
-            sum.add(v);
+        // The chord changes slowly along a piece: computed again (a square root) when a piece
+        // starts and every 8 samples, not for every segment (chord_left: the samples left in
+        // the piece when it was computed, 0: none yet).
+        uint32_t chord_q8 = cv_.chord_q8;
+        const uint16_t since = static_cast<uint16_t>(cv_.chord_left - left);
+        const bool fresh = cv_.chord_left == 0 || left > cv_.chord_left || since >= 8;
+        if (fresh) {
+            Num sum{};
+            uint8_t chord = cv_.chord;
+            for (uint8_t k = 0; k < 3; ++k, chord >>= 1) {
+                if (!(chord & 1)) continue;
+                Num v(abs32(d[k]));
+                v.mul(v).mul(lengths_->inv2[cv_.axes[k]]);
+                sum.add(v);
+            }
+            // mm over 2^16 -> µm x 256: x 256000 / 2^16 = 0xFA000000 x 2^-30 (mul() would take
+            // 256000 as 0xFA000000 x 2^-14, then the shift)
+            chord_q8 = sum.sqrt().mulc(0xFA000000ul, -30).u32();
+            if (chord_q8 == 0) chord_q8 = 1;
         }
-        // mm over 2^16 -> µm x 256: x 256000 / 2^16 = 0xFA000000 x 2^-30 (mul() would take
-        // 256000 as 0xFA000000 x 2^-14, then the shift)
-        uint32_t chord_q8 = sum.sqrt().mulc(0xFA000000ul, -30).u32();
-        if (chord_q8 == 0) chord_q8 = 1;
         // The segment's length depends on the speed only, never on how full the queue is (the
         // chip and the host model must cut the same segments): wait for room for all of it.
         // At most 3 samples (6 runs in the worst case), so that the queue is still half full
@@ -578,6 +587,12 @@ void StepGen::fill_curve(RunQueue& q) {
         }
         if (run_count != 0) emit(q, run_steps, run_dirs, run_count, period_q8);
         cv_.x_q8 += chord_q8 * i;
+        // Kept only for a segment actually made: the chip and the host model stop at different
+        // times for room, and must still use the same chord for the same samples.
+        if (fresh) {
+            cv_.chord_q8 = chord_q8;
+            cv_.chord_left = left;
+        }
 #if LL_STATS
         ++stats.segments;
 #endif

@@ -219,10 +219,13 @@ class StepGen {
         uint8_t cruise_seg;                        ///< segment length at cruise
     };
     struct CurveState {
-        uint32_t ref_um; ///< its length, µm (the profile's reference length)
-        uint32_t x_q8;   ///< distance travelled, µm x 256
-        uint8_t axes[3]; ///< machine axes u, v, w
-        uint8_t chord;   ///< bits (u = 1, v = 2, w = 4) of the axes the path is timed along
+        uint32_t ref_um;     ///< its length, µm (the profile's reference length)
+        uint32_t x_q8;       ///< distance travelled, µm x 256
+        uint8_t axes[3];     ///< machine axes u, v, w
+        uint8_t chord;       ///< bits (u = 1, v = 2, w = 4) of the axes the path is timed along
+        bool circle;         ///< every sample of a piece has the same chord (a circle or helix)
+        uint16_t chord_left; ///< circle: samples that were left in the piece at the last chord
+        uint32_t chord_q8;   ///< circle: that chord, µm x 256
         CurveWalker w;
     };
     union {
