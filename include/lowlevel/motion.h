@@ -15,7 +15,7 @@ struct LineRequest {
     uint32_t feed;               ///< F in units/min x1000; ignored when `rapid`
     bool rapid;                  ///< G0: as fast as every axis allows
     /// The curve from the current position to the target, or nullptr for a straight move.
-    /// Copied by push_line(); its len_q8 is computed there.
+    /// Copied by push_line().
     const CurveParams* curve;
 };
 

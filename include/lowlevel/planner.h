@@ -60,10 +60,10 @@ class Planner {
     /// travels more than kMaxLineTicks.
     bool add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
              bool rapid);
-    /// Queues a curve (seed part IV) from the last target to `target` along `curve` (its
-    /// len_q8 is computed here): its length, its curvature limit (v^2 <= a r) and its end
-    /// tangents (for the junctions) come from curve_shape(). Returns false for a degenerate
-    /// curve. Precondition: curve_slot_free() and !full().
+    /// Queues a curve (seed part IV) from the last target to `target` along `curve`: its length,
+    /// its curvature limit (v^2 <= a r) and its end tangents (for the junctions) come from
+    /// curve_shape(). Returns false for a degenerate curve. Precondition: curve_slot_free() and
+    /// !full().
     bool add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                    const CurveParams& curve);
     /// A curve needs one of kCurveSlots slots besides its block.
