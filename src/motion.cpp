@@ -121,9 +121,8 @@ bool push_line(const LineRequest& req) {
     Motion& m = mo();
     if (too_long(m.planner.last_target(), req.target_steps)) return false;
     if (req.curve) {
-        if (!m.planner.add_curve(req.target_steps, req.target_um, req.feed, *req.curve)) {
-            return false;
-        }
+        if (!m.planner.shape_curve(req.target_um, *req.curve)) return false;
+        m.planner.add_curve(req.target_steps, req.target_um, req.feed, *req.curve);
     } else {
         m.planner.add(req.target_steps, req.target_um, req.feed, req.rapid);
     }

@@ -286,22 +286,28 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t 
     recalculate();
 }
 
-bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
+// The deepest stack of the firmware is curve_shape()'s: it runs from shape_curve(), a frame of a
+// few saved registers, not under add_curve()'s, and its result waits in the free slot, which
+// add_curve() fills with the curve once the shape is used.
+bool Planner::shape_curve(const int32_t target_um[kAxes], const CurveParams& curve) {
+    const uint8_t plane = curve.plane;
+    const bool w_regulated = regulates_w(plane);
+    return curve_shape(curve, w_regulated ? target_um[2 - plane] - last_um_[2 - plane] : 0,
+                       w_regulated, curves_[free_slot_index()].shape);
+}
+
+void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                         const CurveParams& curve) {
     const uint8_t plane = curve.plane;
     const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
-    // The group of the plane's first machine axis (Y for G19, else X).
     const uint8_t group = m_->group_of[plane == 2 ? 1 : 0];
     const uint8_t in_plane = plane_mask(plane);
-    const uint8_t n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated
+    const uint8_t n = regulates_w(plane) ? 3 : 2;
     const int32_t dw_um = target_um[w] - last_um_[w];
-    CurveShape shape;
-    if (!curve_shape(curve, n == 3 ? dw_um : 0, n == 3, shape)) return false;
-    // The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
-    static_assert(kCurveSlots == 2, "one free slot out of two");
-    const uint8_t slot = curve_used_ & 1;
+    const uint8_t slot = free_slot_index();
+    CurveSlot& s = curves_[slot];
+    const CurveShape& shape = s.shape;
     curve_used_ = static_cast<uint8_t>(curve_used_ | (slot + 1));
-    curves_[slot] = curve;
     PlanBlock& b = *at(count_);
     int32_t d[kAxes];
     open(b, target, d);
@@ -326,7 +332,7 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     place(d, shape.start_dir, plane, n);
     finish_block(b, group, static_cast<uint8_t>(slot + 1), feed, shape.len_q8, d);
     place(prev_unit_, shape.end_dir, plane, n);
-    return true;
+    s.params = curve; // over the shape, now used
 }
 
 void Planner::recalculate(bool all) {
@@ -382,7 +388,7 @@ MoveSpec Planner::spec_of_first() const {
     s.group = b->group;
     s.v_nominal2 = speed2_of(s.feed);
     s.v_exit2 = exit2_of_first();
-    s.curve = b->curve ? &curves_[b->curve - 1] : nullptr;
+    s.curve = b->curve ? &curves_[b->curve - 1].params : nullptr;
     s.accel = 0;
     if (s.dv2 == 0xFFFFFFFFul) {
         // dv2 saturated: the acceleration from the limits again.

@@ -60,11 +60,15 @@ class Planner {
     /// travels more than kMaxLineTicks.
     bool add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
              bool rapid);
-    /// Queues a curve (seed part IV) from the last target to `target` along `curve`: its length,
-    /// its curvature limit (v^2 <= a r) and its end tangents (for the junctions) come from
-    /// curve_shape(). Returns false for a degenerate curve. Precondition: curve_slot_free() and
+    /// Queues a curve (seed part IV) from the last target to `target` along `curve`, in two
+    /// calls, so that the deepest computation of the firmware does not stack on top of the
+    /// second one's frame. shape_curve(): the curve's length, curvature limit (v^2 <= a r) and end
+    /// tangents (for the junctions) from curve_shape(), kept in the free curve slot; false for a
+    /// degenerate curve (then nothing is queued, and add_curve() must not be called). Then
+    /// add_curve() with the same `target_um` and `curve`. Precondition: curve_slot_free() and
     /// !full().
-    bool add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
+    bool shape_curve(const int32_t target_um[kAxes], const CurveParams& curve);
+    void add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                    const CurveParams& curve);
     /// A curve needs one of kCurveSlots slots besides its block.
     bool curve_slot_free() const { return curve_used_ != (1u << kCurveSlots) - 1; }
@@ -115,6 +119,25 @@ class Planner {
     void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed, uint32_t len_q8,
                       const int32_t unit_in[kAxes]);
 
+    /// A curve's slot: its parameters while its move is queued; before that, while the move is
+    /// being queued, the curve's shape (shape_curve()).
+    union CurveSlot {
+        CurveParams params;
+        CurveShape shape;
+    };
+    static_assert(sizeof(CurveShape) <= sizeof(CurveParams), "the shape costs no RAM");
+    /// The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
+    uint8_t free_slot_index() const {
+        static_assert(kCurveSlots == 2, "one free slot out of two");
+        return curve_used_ & 1;
+    }
+    /// True when the normal axis of `plane` is regulated with the plane's axes (it counts in a
+    /// curve's length).
+    bool regulates_w(uint8_t plane) const {
+        // The group of the plane's first machine axis (Y for G19, else X), and the normal axis.
+        return (m_->group_of[plane == 2 ? 1 : 0] & (4 >> plane)) != 0;
+    }
+
     // The small fields first: within 64 bytes of `this`, the ATmega328P reaches them with one
     // displacement instruction instead of an address computation.
     const Machine* m_;
@@ -125,7 +148,7 @@ class Planner {
     int32_t last_[kAxes];
     int32_t last_um_[kAxes];
     int32_t prev_unit_[kAxes]; ///< unit vector of the last move, Q29
-    CurveParams curves_[kCurveSlots];
+    CurveSlot curves_[kCurveSlots];
     PlanBlock ring_[kPlannerSize];
 };
 
