@@ -228,7 +228,12 @@ struct Work {
         motion::LineRequest req;
     };
 };
-Work w;
+// In the motion side's scratch RAM (motion.h: it is ours from execute() until push_line()).
+static_assert(sizeof(void*) != 2 || sizeof(Work) == motion::kScratchBytes,
+              "motion::kScratchBytes is the size of the work block on the AVR");
+inline Work& work() {
+    return motion::scratch<Work>();
+}
 
 // The first decimal of a command number (G92.1 -> 1), or 0xFF with a finer fraction (G1.05).
 uint8_t tenths(const num::Decimal& d) {
@@ -305,7 +310,7 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
 
 // A length word in the units of the block, to um (or a feed to mm/min x1000).
 __attribute__((noinline)) bool length(const num::Decimal& d, int32_t& out) {
-    return num::length_to_milli(d, w.b.g[kGroupUnits] != 0, out);
+    return num::length_to_milli(d, work().b.g[kGroupUnits] != 0, out);
 }
 
 // a + b, or a - b with `subtract`; an overflow sets Block::overflow (checked once per line:
@@ -314,7 +319,7 @@ __attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = fals
     uint32_t ua = static_cast<uint32_t>(a), ub = static_cast<uint32_t>(b);
     uint32_t r = subtract ? ua - ub : ua + ub;
     if (subtract) ub = ~ub; // a - b overflows as a + ~b would (the sign of -b is ~b's)
-    if (((ua ^ r) & (ub ^ r)) >> 31) w.b.overflow = 1;
+    if (((ua ^ r) & (ub ^ r)) >> 31) work().b.overflow = 1;
     return static_cast<int32_t>(r);
 }
 
@@ -442,7 +447,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         }
         if (k < 2) {
             c.start_um[k] = st.position[ax[k]];
-            c.end_um[k] = w.req.target_um[ax[k]];
+            c.end_um[k] = work().req.target_um[ax[k]];
         }
     }
     int32_t d[2]; // end - start
@@ -532,7 +537,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             c.turns = static_cast<uint8_t>(turns - 1);
         }
     }
-    if (!curve_in_range(c, ax, add(w.req.target_um[ax[2]], st.position[ax[2]], true))) {
+    if (!curve_in_range(c, ax, add(work().req.target_um[ax[2]], st.position[ax[2]], true))) {
         return kInvalidTarget;
     }
     if (b.overflow) return kInvalidTarget;
@@ -549,6 +554,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     outcome.dwell_ms = 0;
 
     // ---- Stage 1: a block that starts from the current modes.
+    Work& w = work();
     Block& b = w.b;
     static_assert(offsetof(State, tool) == sizeof(Modal) && sizeof(Modal) + 1 == 8,
                   "modal and tool are two words");

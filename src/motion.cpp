@@ -35,7 +35,9 @@ void produce(Motion& m) {
     for (;;) {
         if (!m.begun) {
             if (m.planner.empty()) return;
-            if (!m.gen.begin(m.planner.spec_of_first())) { // no step: drop it
+            MoveSpec& spec = scratch<MoveSpec>(); // see motion.h
+            m.planner.spec_of_first(spec);
+            if (!m.gen.begin(spec)) { // no step: drop it
                 m.planner.discard_first();
                 continue;
             }
@@ -101,6 +103,8 @@ void restart(Motion& m, const int32_t here[kAxes]) {
 }
 
 } // namespace
+
+alignas(alignof(void*)) uint8_t g_scratch[kScratchBytes]; // 1 on the AVR, 8 on the host
 
 void init() {
     int32_t zero[kAxes] = {};

@@ -373,9 +373,8 @@ void Planner::recalculate(bool all) {
     }
 }
 
-MoveSpec Planner::spec_of_first() const {
+void Planner::spec_of_first(MoveSpec& s) const {
     const PlanBlock* const b = ring_ + head_;
-    MoveSpec s;
     for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(*b, a);
     s.len_q8 = b->len_q8;
     // dv2 (the profile from the planner's own 2 a L), feed, v_entry2: one copy.
@@ -402,7 +401,6 @@ MoveSpec Planner::spec_of_first() const {
             s.accel = lim.accel;
         }
     }
-    return s;
 }
 
 uint32_t Planner::exit2_of_first() const {

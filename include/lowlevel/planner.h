@@ -76,7 +76,7 @@ class Planner {
     /// The i-th queued move (0 = oldest). Precondition: i < count().
     const PlanBlock& block(uint8_t i) const { return ring_[index(i)]; }
     /// The oldest move as the step generator needs it (entry and planned exit speeds).
-    MoveSpec spec_of_first() const;
+    void spec_of_first(MoveSpec& s) const;
     /// Planned exit speed squared of the oldest move (the next one's entry, 0 at the end).
     uint32_t exit2_of_first() const;
     /// The step generator started the oldest move: its entry speed is now fixed.
