@@ -290,10 +290,12 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t 
 // few saved registers, not under add_curve()'s, and its result waits in the free slot, which
 // add_curve() fills with the curve once the shape is used.
 bool Planner::shape_curve(const int32_t target_um[kAxes], const CurveParams& curve) {
-    const uint8_t plane = curve.plane;
-    const bool w_regulated = regulates_w(plane);
-    return curve_shape(curve, w_regulated ? target_um[2 - plane] - last_um_[2 - plane] : 0,
-                       w_regulated, curves_[free_slot_index()].shape);
+    const uint8_t w = static_cast<uint8_t>(2 - curve.plane); // the normal axis
+    const bool w_regulated = regulates_w(curve.plane);
+    int32_t dw_um = 0;
+    if (w_regulated) dw_um = target_um[w] - last_um_[w];
+    CurveSlot* const s = free_slot_index() ? curves_ + 1 : curves_;
+    return curve_shape(curve, dw_um, w_regulated, s->shape);
 }
 
 void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
@@ -302,10 +304,10 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
     const uint8_t group = m_->group_of[plane == 2 ? 1 : 0];
     const uint8_t in_plane = plane_mask(plane);
-    const uint8_t n = regulates_w(plane) ? 3 : 2;
+    const uint8_t n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
     const int32_t dw_um = target_um[w] - last_um_[w];
     const uint8_t slot = free_slot_index();
-    CurveSlot& s = curves_[slot];
+    CurveSlot& s = slot ? curves_[1] : curves_[0];
     const CurveShape& shape = s.shape;
     curve_used_ = static_cast<uint8_t>(curve_used_ | (slot + 1));
     PlanBlock& b = *at(count_);
@@ -387,7 +389,8 @@ void Planner::spec_of_first(MoveSpec& s) const {
     s.group = b->group;
     s.v_nominal2 = speed2_of(s.feed);
     s.v_exit2 = exit2_of_first();
-    s.curve = b->curve ? &curves_[b->curve - 1].params : nullptr;
+    // Slot b->curve - 1 (two slots: no multiplication by the slot size).
+    s.curve = b->curve ? &(b->curve == 1 ? curves_[0] : curves_[1]).params : nullptr;
     s.accel = 0;
     if (s.dv2 == 0xFFFFFFFFul) {
         // dv2 saturated: the acceleration from the limits again.
