@@ -61,7 +61,8 @@ __attribute__((noinline)) bool tiny(const Num& x) {
 
 // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated length:
 // Euclidean over the move's group (seed §3.1), at least 1.
-uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uint32_t x[kAxes]) {
+__attribute__((noinline)) uint32_t travel(const Machine& m, const int32_t delta[kAxes],
+                                          uint8_t group, uint32_t x[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
     return at_least_1(sum_squares(x, kAxes, group).sqrt().u32());
 }
@@ -259,16 +260,15 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (u > (1ul << 29)) u = 1ul << 29;
         unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
-    finish_block(b, group, 0, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), lim.len_q8, unit);
+    finish_block(b, group, 0, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), unit);
     for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
     return true;
 }
 
 void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
-                           uint32_t len_q8, const int32_t unit_in[kAxes]) {
+                           const int32_t unit_in[kAxes]) {
     b.group = group & 0x3F;
     b.curve = curve & 3;
-    b.len_q8 = len_q8;
     b.feed = at_least_1(feed);
     // From rest after no queued move or one of another group; else the junction, within
     // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
@@ -332,8 +332,9 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
     place(d, shape.start_dir, plane, n);
-    finish_block(b, group, static_cast<uint8_t>(slot + 1), feed, shape.len_q8, d);
+    finish_block(b, group, static_cast<uint8_t>(slot + 1), feed, d);
     place(prev_unit_, shape.end_dir, plane, n);
+    s.len_q8 = shape.len_q8;
     s.params = curve; // over the shape, now used
 }
 
@@ -378,7 +379,6 @@ void Planner::recalculate(bool all) {
 void Planner::spec_of_first(MoveSpec& s) const {
     const PlanBlock* const b = ring_ + head_;
     for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(*b, a);
-    s.len_q8 = b->len_q8;
     // dv2 (the profile from the planner's own 2 a L), feed, v_entry2: one copy.
     static_assert(offsetof(MoveSpec, feed) == offsetof(MoveSpec, dv2) + 4 &&
                       offsetof(MoveSpec, v_entry2) == offsetof(MoveSpec, dv2) + 8 &&
@@ -389,8 +389,18 @@ void Planner::spec_of_first(MoveSpec& s) const {
     s.group = b->group;
     s.v_nominal2 = speed2_of(s.feed);
     s.v_exit2 = exit2_of_first();
-    // Slot b->curve - 1 (two slots: no multiplication by the slot size).
-    s.curve = b->curve ? &(b->curve == 1 ? curves_[0] : curves_[1]).params : nullptr;
+    s.curve = nullptr;
+    if (b->curve) {
+        // Slot b->curve - 1 (two slots: no multiplication by the slot size).
+        const CurveSlot& c = b->curve == 1 ? curves_[0] : curves_[1];
+        s.curve = &c.params;
+        s.len_q8 = c.len_q8;
+    } else {
+        // The length add() had: the same deltas, group and settings (they only change while
+        // nothing is queued).
+        uint32_t x[kAxes];
+        s.len_q8 = travel(*m_, s.delta, s.group, x);
+    }
     s.accel = 0;
     if (s.dv2 == 0xFFFFFFFFul) {
         // dv2 saturated: the acceleration from the limits again.

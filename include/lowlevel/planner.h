@@ -3,10 +3,11 @@
 // from, recomputed as moves arrive (backward then forward pass). Speeds are squared, in
 // (units/min)^2 of each move's regulated path (seed §3.1); integer only.
 //
-// A queued move costs 33 bytes of RAM (4 axes): deltas are kept on 24 bits, the group and the
-// curve slot share a byte; the length is kept (the step generator needs it when the move starts,
-// and recomputing it took a square root per move) and the acceleration is derived from dv2 and
-// the length instead of being stored.
+// A queued move costs 29 bytes of RAM (4 axes): deltas are kept on 24 bits, the group and the
+// curve slot share a byte; a line's length is recomputed from its deltas when the step generator
+// starts it (a square root per move, against 4 bytes per block: RAM is the limit), a curve's is
+// kept in its slot (it takes a quadrature); the acceleration is derived from dv2 and the length
+// instead of being stored.
 #pragma once
 
 #include "lowlevel/machine.h"
@@ -22,7 +23,6 @@ struct PlanBlock {
     uint8_t delta[kAxes][3]; ///< steps per machine axis, signed 24-bit little-endian
     uint8_t group : 6;       ///< regulated axes (seed §3.1)
     uint8_t curve : 2;       ///< 0: a straight move; else 1 + the slot of its curve
-    uint32_t len_q8;         ///< length of the regulated path, µm x 256 (for the step generator)
     // dv2, feed, v_entry2: in MoveSpec's order (spec_of_first() copies them at once).
     uint32_t dv2;          ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
     uint32_t feed;         ///< nominal speed, units/min x1000
@@ -116,14 +116,17 @@ class Planner {
     /// Completes the block being queued (its deltas, curve and dv2 written): feed (at least 1),
     /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes. The
     /// caller then sets prev_unit_ to the direction it ends along.
-    void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed, uint32_t len_q8,
+    void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
                       const int32_t unit_in[kAxes]);
 
-    /// A curve's slot: its parameters while its move is queued; before that, while the move is
-    /// being queued, the curve's shape (shape_curve()).
-    union CurveSlot {
-        CurveParams params;
-        CurveShape shape;
+    /// A curve's slot: its parameters and length while its move is queued; before that, while
+    /// the move is being queued, the curve's shape (shape_curve()).
+    struct CurveSlot {
+        union {
+            CurveParams params;
+            CurveShape shape;
+        };
+        uint32_t len_q8; ///< µm x 256
     };
     static_assert(sizeof(CurveShape) <= sizeof(CurveParams), "the shape costs no RAM");
     /// The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
