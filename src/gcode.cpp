@@ -381,9 +381,12 @@ __attribute__((noinline)) uint32_t ellipse_gap_um(const int32_t p[2], const int3
 // The step generator's fixed-point range (docs/curves.md): the ends, the control points or the
 // centre, and the semi-axes, within 2^22 steps; the length within 2^23 um (an arc's is at most
 // its larger semi-axis times its sweep; a Bezier's at most its control polygon's), and the
-// normal axis' travel `dw_um` too. (A function of its own: a small stack frame.)
-__attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_t ax[3],
-                                              int32_t dw_um) {
+// normal axis' travel too (an overflow of it flags the block). A function of its own, called by
+// execute() after check_curve() rather than under its frame: the deepest stack of a G-code line.
+__attribute__((noinline)) bool curve_in_range(const CurveParams& c) {
+    uint8_t ax[3];
+    plane_axes(c.plane, ax);
+    const int32_t dw_um = add(work().req.target_um[ax[2]], g_state.position[ax[2]], true);
     Num reach{};                                                          // length bound, um
     const int32_t* const pts[4] = {c.start_um, c.a_um, c.b_um, c.end_um}; // a G5's polygon
     for (uint8_t i = 0; i < 4; ++i) {
@@ -537,10 +540,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             c.turns = static_cast<uint8_t>(turns - 1);
         }
     }
-    if (!curve_in_range(c, ax, add(work().req.target_um[ax[2]], st.position[ax[2]], true))) {
-        return kInvalidTarget;
-    }
-    if (b.overflow) return kInvalidTarget;
+    if (b.overflow) return kInvalidTarget; // (curve_in_range() follows, in execute())
     b.words = static_cast<WordMask>(b.words & ~used);
     return kOk;
 }
@@ -707,6 +707,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         if (motion >= Motion::ArcCw && motion <= Motion::Bezier) {
             uint8_t r = check_curve(b, motion, axes, st, b.curve);
             if (r != kOk) return r;
+            if (!curve_in_range(b.curve) || b.overflow) return kInvalidTarget;
             curve = true;
         } else if (axes == 0) {
             b.axis_command = kAxisNone; // G0/G1 alone: a mode change only
