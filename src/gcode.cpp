@@ -421,6 +421,20 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c) {
     return reach.cmp(Num(1, 23)) < 0;
 }
 
+// An ellipse's ends on it: within one tick (the larger step of the plane's axes) + 0.002 mm. A
+// function of its own, called by execute() after check_curve() rather than under its frame, as
+// curve_in_range() (both reach ellipse_direction(): the deepest stack of a G-code line).
+__attribute__((noinline)) bool ellipse_ends_on(const CurveParams& c) {
+    uint8_t ax[3];
+    plane_axes(c.plane, ax);
+    const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
+    uint32_t spu = g_settings.axis[ax[0]].steps_per_unit;
+    uint32_t spv = g_settings.axis[ax[1]].steps_per_unit;
+    uint32_t tol = 1000000ul / (spu < spv ? spu : spv) + 2; // the larger step + 2 um
+    return ellipse_gap_um(c.start_um, c.a_um, radii) <= tol &&
+           ellipse_gap_um(c.end_um, c.a_um, radii) <= tol;
+}
+
 // Stage 3 of a curve (docs/curves.md): the checks and errors of GRBL's arcs (26 32 33 34 35), our
 // extensions' (ellipses, G5), and the geometry handed to the planner. Consumes its words.
 __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t axes,
@@ -471,7 +485,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         }
     } else if (ellipse) {
         // G2.1 / G3.1: I J the centre from the start, P Q the semi-axes along the plane's
-        // axes; both ends on the ellipse within one tick + 0.002 mm (checked below).
+        // axes; both ends on the ellipse within one tick + 0.002 mm (ellipse_ends_on()).
         if (!has_offsets) return kNoOffsetsInPlane;
         if (!has_pq) return kValueWordMissing;
         if (o[2] <= 0 || o[3] <= 0) return kNegativeValue;
@@ -513,15 +527,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         c.a_um[k] = add(c.start_um[k], o[k]);
         c.b_um[k] = bezier ? add(c.end_um[k], o[k + 2]) : o[k + 2];
     }
-    if (ellipse) {
-        const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
-        uint32_t spu = g_settings.axis[u].steps_per_unit, spv = g_settings.axis[v].steps_per_unit;
-        uint32_t tol = 1000000ul / (spu < spv ? spu : spv) + 2; // the larger step + 2 um
-        if (ellipse_gap_um(c.start_um, c.a_um, radii) > tol ||
-            ellipse_gap_um(c.end_um, c.a_um, radii) > tol) {
-            return kInvalidTarget;
-        }
-    } else if (!bezier) {
+    if (!ellipse && !bezier) { // (an ellipse's ends: ellipse_ends_on(), after this)
         if (!(b.words & bit(kWordR))) {
             // The end must be on the circle: within 0.005 mm, or else within 0.5 mm and 0.1 %.
             Num rn = dist_um(c.start_um, c.a_um);
@@ -707,7 +713,10 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         if (motion >= Motion::ArcCw && motion <= Motion::Bezier) {
             uint8_t r = check_curve(b, motion, axes, st, b.curve);
             if (r != kOk) return r;
-            if (!curve_in_range(b.curve) || b.overflow) return kInvalidTarget;
+            // (In check_curve()'s order: the ends of an ellipse, the range, the overflows.)
+            if ((ellipse && !ellipse_ends_on(b.curve)) || !curve_in_range(b.curve) || b.overflow) {
+                return kInvalidTarget;
+            }
             curve = true;
         } else if (axes == 0) {
             b.axis_command = kAxisNone; // G0/G1 alone: a mode change only
