@@ -286,18 +286,9 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t 
     recalculate();
 }
 
-// The deepest stack of the firmware is curve_shape()'s: it runs from shape_curve(), a frame of a
-// few saved registers, not under add_curve()'s, and its result waits in the free slot, which
-// add_curve() fills with the curve once the shape is used.
-bool Planner::shape_curve(const int32_t target_um[kAxes], const CurveParams& curve) {
-    const uint8_t w = static_cast<uint8_t>(2 - curve.plane); // the normal axis
-    const bool w_regulated = regulates_w(curve.plane);
-    int32_t dw_um = 0;
-    if (w_regulated) dw_um = target_um[w] - last_um_[w];
-    CurveSlot* const s = free_slot_index() ? curves_ + 1 : curves_;
-    return curve_shape(curve, dw_um, w_regulated, s->shape);
-}
-
+// The deepest stack of the firmware is curve_shape()'s: shape_curve() (inline: curve_shape()
+// runs straight under push_line()) keeps its result in the free slot, and add_curve() fills the
+// slot with the curve once the shape is used.
 void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                         const CurveParams& curve) {
     const uint8_t plane = curve.plane;

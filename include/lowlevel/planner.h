@@ -67,7 +67,14 @@ class Planner {
     /// degenerate curve (then nothing is queued, and add_curve() must not be called). Then
     /// add_curve() with the same `target_um` and `curve`. Precondition: curve_slot_free() and
     /// !full().
-    bool shape_curve(const int32_t target_um[kAxes], const CurveParams& curve);
+    bool shape_curve(const int32_t target_um[kAxes], const CurveParams& curve) {
+        const uint8_t w = static_cast<uint8_t>(2 - curve.plane); // the normal axis
+        const bool w_regulated = regulates_w(curve.plane);
+        int32_t dw_um = 0;
+        if (w_regulated) dw_um = target_um[w] - last_um_[w];
+        CurveSlot* const s = free_slot_index() ? curves_ + 1 : curves_;
+        return curve_shape(curve, dw_um, w_regulated, s->shape);
+    }
     void add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                    const CurveParams& curve);
     /// A curve needs one of kCurveSlots slots besides its block.
