@@ -228,7 +228,12 @@ struct Work {
         motion::LineRequest req;
     };
 };
-Work w;
+// In the motion side's scratch RAM (motion.h: it is ours from execute() until push_line()).
+static_assert(sizeof(void*) != 2 || sizeof(Work) == motion::kScratchBytes,
+              "motion::kScratchBytes is the size of the work block on the AVR");
+inline Work& work() {
+    return motion::scratch<Work>();
+}
 
 // The first decimal of a command number (G92.1 -> 1), or 0xFF with a finer fraction (G1.05).
 uint8_t tenths(const num::Decimal& d) {
@@ -305,7 +310,7 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
 
 // A length word in the units of the block, to um (or a feed to mm/min x1000).
 __attribute__((noinline)) bool length(const num::Decimal& d, int32_t& out) {
-    return num::length_to_milli(d, w.b.g[kGroupUnits] != 0, out);
+    return num::length_to_milli(d, work().b.g[kGroupUnits] != 0, out);
 }
 
 // a + b, or a - b with `subtract`; an overflow sets Block::overflow (checked once per line:
@@ -314,7 +319,7 @@ __attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = fals
     uint32_t ua = static_cast<uint32_t>(a), ub = static_cast<uint32_t>(b);
     uint32_t r = subtract ? ua - ub : ua + ub;
     if (subtract) ub = ~ub; // a - b overflows as a + ~b would (the sign of -b is ~b's)
-    if (((ua ^ r) & (ub ^ r)) >> 31) w.b.overflow = 1;
+    if (((ua ^ r) & (ub ^ r)) >> 31) work().b.overflow = 1;
     return static_cast<int32_t>(r);
 }
 
@@ -376,9 +381,12 @@ __attribute__((noinline)) uint32_t ellipse_gap_um(const int32_t p[2], const int3
 // The step generator's fixed-point range (docs/curves.md): the ends, the control points or the
 // centre, and the semi-axes, within 2^22 steps; the length within 2^23 um (an arc's is at most
 // its larger semi-axis times its sweep; a Bezier's at most its control polygon's), and the
-// normal axis' travel `dw_um` too. (A function of its own: a small stack frame.)
-__attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_t ax[3],
-                                              int32_t dw_um) {
+// normal axis' travel too (an overflow of it flags the block). A function of its own, called by
+// execute() after check_curve() rather than under its frame: the deepest stack of a G-code line.
+__attribute__((noinline)) bool curve_in_range(const CurveParams& c) {
+    uint8_t ax[3];
+    plane_axes(c.plane, ax);
+    const int32_t dw_um = add(work().req.target_um[ax[2]], g_state.position[ax[2]], true);
     Num reach{};                                                          // length bound, um
     const int32_t* const pts[4] = {c.start_um, c.a_um, c.b_um, c.end_um}; // a G5's polygon
     for (uint8_t i = 0; i < 4; ++i) {
@@ -413,6 +421,20 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
     return reach.cmp(Num(1, 23)) < 0;
 }
 
+// An ellipse's ends on it: within one tick (the larger step of the plane's axes) + 0.002 mm. A
+// function of its own, called by execute() after check_curve() rather than under its frame, as
+// curve_in_range() (both reach ellipse_direction(): the deepest stack of a G-code line).
+__attribute__((noinline)) bool ellipse_ends_on(const CurveParams& c) {
+    uint8_t ax[3];
+    plane_axes(c.plane, ax);
+    const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
+    uint32_t spu = g_settings.axis[ax[0]].steps_per_unit;
+    uint32_t spv = g_settings.axis[ax[1]].steps_per_unit;
+    uint32_t tol = 1000000ul / (spu < spv ? spu : spv) + 2; // the larger step + 2 um
+    return ellipse_gap_um(c.start_um, c.a_um, radii) <= tol &&
+           ellipse_gap_um(c.end_um, c.a_um, radii) <= tol;
+}
+
 // Stage 3 of a curve (docs/curves.md): the checks and errors of GRBL's arcs (26 32 33 34 35), our
 // extensions' (ellipses, G5), and the geometry handed to the planner. Consumes its words.
 __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t axes,
@@ -442,7 +464,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         }
         if (k < 2) {
             c.start_um[k] = st.position[ax[k]];
-            c.end_um[k] = w.req.target_um[ax[k]];
+            c.end_um[k] = work().req.target_um[ax[k]];
         }
     }
     int32_t d[2]; // end - start
@@ -463,7 +485,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         }
     } else if (ellipse) {
         // G2.1 / G3.1: I J the centre from the start, P Q the semi-axes along the plane's
-        // axes; both ends on the ellipse within one tick + 0.002 mm (checked below).
+        // axes; both ends on the ellipse within one tick + 0.002 mm (ellipse_ends_on()).
         if (!has_offsets) return kNoOffsetsInPlane;
         if (!has_pq) return kValueWordMissing;
         if (o[2] <= 0 || o[3] <= 0) return kNegativeValue;
@@ -505,15 +527,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         c.a_um[k] = add(c.start_um[k], o[k]);
         c.b_um[k] = bezier ? add(c.end_um[k], o[k + 2]) : o[k + 2];
     }
-    if (ellipse) {
-        const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
-        uint32_t spu = g_settings.axis[u].steps_per_unit, spv = g_settings.axis[v].steps_per_unit;
-        uint32_t tol = 1000000ul / (spu < spv ? spu : spv) + 2; // the larger step + 2 um
-        if (ellipse_gap_um(c.start_um, c.a_um, radii) > tol ||
-            ellipse_gap_um(c.end_um, c.a_um, radii) > tol) {
-            return kInvalidTarget;
-        }
-    } else if (!bezier) {
+    if (!ellipse && !bezier) { // (an ellipse's ends: ellipse_ends_on(), after this)
         if (!(b.words & bit(kWordR))) {
             // The end must be on the circle: within 0.005 mm, or else within 0.5 mm and 0.1 %.
             Num rn = dist_um(c.start_um, c.a_um);
@@ -532,10 +546,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             c.turns = static_cast<uint8_t>(turns - 1);
         }
     }
-    if (!curve_in_range(c, ax, add(w.req.target_um[ax[2]], st.position[ax[2]], true))) {
-        return kInvalidTarget;
-    }
-    if (b.overflow) return kInvalidTarget;
+    if (b.overflow) return kInvalidTarget; // (curve_in_range() follows, in execute())
     b.words = static_cast<WordMask>(b.words & ~used);
     return kOk;
 }
@@ -549,6 +560,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     outcome.dwell_ms = 0;
 
     // ---- Stage 1: a block that starts from the current modes.
+    Work& w = work();
     Block& b = w.b;
     static_assert(offsetof(State, tool) == sizeof(Modal) && sizeof(Modal) + 1 == 8,
                   "modal and tool are two words");
@@ -701,6 +713,10 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         if (motion >= Motion::ArcCw && motion <= Motion::Bezier) {
             uint8_t r = check_curve(b, motion, axes, st, b.curve);
             if (r != kOk) return r;
+            // (In check_curve()'s order: the ends of an ellipse, the range, the overflows.)
+            if ((ellipse && !ellipse_ends_on(b.curve)) || !curve_in_range(b.curve) || b.overflow) {
+                return kInvalidTarget;
+            }
             curve = true;
         } else if (axes == 0) {
             b.axis_command = kAxisNone; // G0/G1 alone: a mode change only

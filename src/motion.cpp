@@ -35,7 +35,9 @@ void produce(Motion& m) {
     for (;;) {
         if (!m.begun) {
             if (m.planner.empty()) return;
-            if (!m.gen.begin(m.planner.spec_of_first())) { // no step: drop it
+            MoveSpec& spec = scratch<MoveSpec>(); // see motion.h
+            m.planner.spec_of_first(spec);
+            if (!m.gen.begin(spec)) { // no step: drop it
                 m.planner.discard_first();
                 continue;
             }
@@ -102,6 +104,8 @@ void restart(Motion& m, const int32_t here[kAxes]) {
 
 } // namespace
 
+alignas(alignof(void*)) uint8_t g_scratch[kScratchBytes]; // 1 on the AVR, 8 on the host
+
 void init() {
     int32_t zero[kAxes] = {};
     restart(mo(), zero);
@@ -121,9 +125,8 @@ bool push_line(const LineRequest& req) {
     Motion& m = mo();
     if (too_long(m.planner.last_target(), req.target_steps)) return false;
     if (req.curve) {
-        if (!m.planner.add_curve(req.target_steps, req.target_um, req.feed, *req.curve)) {
-            return false;
-        }
+        if (!m.planner.shape_curve(req.target_um, *req.curve)) return false;
+        m.planner.add_curve(req.target_steps, req.target_um, req.feed, *req.curve);
     } else {
         m.planner.add(req.target_steps, req.target_um, req.feed, req.rapid);
     }

@@ -61,7 +61,8 @@ __attribute__((noinline)) bool tiny(const Num& x) {
 
 // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated length:
 // Euclidean over the move's group (seed §3.1), at least 1.
-uint32_t travel(const Machine& m, const int32_t delta[kAxes], uint8_t group, uint32_t x[kAxes]) {
+__attribute__((noinline)) uint32_t travel(const Machine& m, const int32_t delta[kAxes],
+                                          uint8_t group, uint32_t x[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a) x[a] = m.um_q8_per_step[a].of(abs32(delta[a]));
     return at_least_1(sum_squares(x, kAxes, group).sqrt().u32());
 }
@@ -259,16 +260,15 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (u > (1ul << 29)) u = 1ul << 29;
         unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
-    finish_block(b, group, 0, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), lim.len_q8, unit);
+    finish_block(b, group, 0, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), unit);
     for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
     return true;
 }
 
 void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
-                           uint32_t len_q8, const int32_t unit_in[kAxes]) {
+                           const int32_t unit_in[kAxes]) {
     b.group = group & 0x3F;
     b.curve = curve & 3;
-    b.len_q8 = len_q8;
     b.feed = at_least_1(feed);
     // From rest after no queued move or one of another group; else the junction, within
     // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
@@ -286,22 +286,21 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t 
     recalculate();
 }
 
-bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
+// The deepest stack of the firmware is curve_shape()'s: shape_curve() (inline: curve_shape()
+// runs straight under push_line()) keeps its result in the free slot, and add_curve() fills the
+// slot with the curve once the shape is used.
+void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                         const CurveParams& curve) {
     const uint8_t plane = curve.plane;
     const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
-    // The group of the plane's first machine axis (Y for G19, else X).
     const uint8_t group = m_->group_of[plane == 2 ? 1 : 0];
     const uint8_t in_plane = plane_mask(plane);
-    const uint8_t n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated
+    const uint8_t n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
     const int32_t dw_um = target_um[w] - last_um_[w];
-    CurveShape shape;
-    if (!curve_shape(curve, n == 3 ? dw_um : 0, n == 3, shape)) return false;
-    // The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
-    static_assert(kCurveSlots == 2, "one free slot out of two");
-    const uint8_t slot = curve_used_ & 1;
+    const uint8_t slot = free_slot_index();
+    CurveSlot& s = slot ? curves_[1] : curves_[0];
+    const CurveShape& shape = s.shape;
     curve_used_ = static_cast<uint8_t>(curve_used_ | (slot + 1));
-    curves_[slot] = curve;
     PlanBlock& b = *at(count_);
     int32_t d[kAxes];
     open(b, target, d);
@@ -324,9 +323,10 @@ bool Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
     place(d, shape.start_dir, plane, n);
-    finish_block(b, group, static_cast<uint8_t>(slot + 1), feed, shape.len_q8, d);
+    finish_block(b, group, static_cast<uint8_t>(slot + 1), feed, d);
     place(prev_unit_, shape.end_dir, plane, n);
-    return true;
+    s.len_q8 = shape.len_q8;
+    s.params = curve; // over the shape, now used
 }
 
 void Planner::recalculate(bool all) {
@@ -367,11 +367,9 @@ void Planner::recalculate(bool all) {
     }
 }
 
-MoveSpec Planner::spec_of_first() const {
+void Planner::spec_of_first(MoveSpec& s) const {
     const PlanBlock* const b = ring_ + head_;
-    MoveSpec s;
     for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(*b, a);
-    s.len_q8 = b->len_q8;
     // dv2 (the profile from the planner's own 2 a L), feed, v_entry2: one copy.
     static_assert(offsetof(MoveSpec, feed) == offsetof(MoveSpec, dv2) + 4 &&
                       offsetof(MoveSpec, v_entry2) == offsetof(MoveSpec, dv2) + 8 &&
@@ -382,7 +380,18 @@ MoveSpec Planner::spec_of_first() const {
     s.group = b->group;
     s.v_nominal2 = speed2_of(s.feed);
     s.v_exit2 = exit2_of_first();
-    s.curve = b->curve ? &curves_[b->curve - 1] : nullptr;
+    s.curve = nullptr;
+    if (b->curve) {
+        // Slot b->curve - 1 (two slots: no multiplication by the slot size).
+        const CurveSlot& c = b->curve == 1 ? curves_[0] : curves_[1];
+        s.curve = &c.params;
+        s.len_q8 = c.len_q8;
+    } else {
+        // The length add() had: the same deltas, group and settings (they only change while
+        // nothing is queued).
+        uint32_t x[kAxes];
+        s.len_q8 = travel(*m_, s.delta, s.group, x);
+    }
     s.accel = 0;
     if (s.dv2 == 0xFFFFFFFFul) {
         // dv2 saturated: the acceleration from the limits again.
@@ -396,7 +405,6 @@ MoveSpec Planner::spec_of_first() const {
             s.accel = lim.accel;
         }
     }
-    return s;
 }
 
 uint32_t Planner::exit2_of_first() const {

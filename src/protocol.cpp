@@ -41,7 +41,7 @@ enum class Wait : uint8_t {
     WhenAccepting, // the planner is full: execute again when it has room
     WhenIdle,      // G10/G92: execute again when motion is idle
     DwellWhenIdle, // G4: start the dwell when motion is idle
-    Dwell,         // G4: until `dwell` (then a hal::millis() time)
+    Dwell,         // G4: until `o.dwell_ms` (then a hal::millis() time)
     PauseWhenIdle, // M0: hold when motion is idle
     Paused,        // M0: until cycle start ('~')
     EndWhenIdle,   // M2/M30: [MSG:Pgm End] when motion is idle
@@ -63,7 +63,9 @@ struct Protocol {
     Wait wait;
     uint8_t check;
     uint8_t wco_countdown; // status reports until WCO: is shown again
-    uint32_t dwell;        // G4: ms, then (Wait::Dwell) hal::millis() at its end
+    // What gcode::execute() asked for (static: not a frame under which the move is planned);
+    // o.dwell_ms: G4 ms, then (Wait::Dwell) hal::millis() at its end.
+    gcode::Outcome o;
     // Kept by a soft reset:
     uint8_t alarm;
     uint8_t rx_capacity; // receive buffer size, for `$I`
@@ -241,12 +243,11 @@ __attribute__((noinline)) uint8_t system_command() {
 }
 
 void run_gcode() {
-    gcode::Outcome o;
+    gcode::Outcome& o = p.o;
     uint8_t r = gcode::execute(
         p.line, static_cast<uint8_t>(p.gflags | (p.check ? gcode::kCheckMode : 0)), o);
     if (o.move) motion::push_line(*o.move); // planned here, not under execute()'s frame
     if (r >= gcode::kRetryWhenAccepting) {
-        p.dwell = o.dwell_ms;
         p.wait = static_cast<Wait>(r - gcode::kRetryWhenAccepting + uint8_t(Wait::WhenAccepting));
     } else if (r == kOk && o.then != gcode::Then::Nothing) {
         p.wait = o.then == gcode::Then::Pause ? Wait::PauseWhenIdle : Wait::EndWhenIdle;
@@ -334,7 +335,7 @@ void advance_wait() {
         return;
     }
     if (w == Wait::Dwell) {
-        if (static_cast<int32_t>(hal::millis() - p.dwell) >= 0) {
+        if (static_cast<int32_t>(hal::millis() - p.o.dwell_ms) >= 0) {
             p.gflags = gcode::kDwellDone;
             run_gcode();
         }
@@ -345,7 +346,7 @@ void advance_wait() {
     if (w == Wait::WhenIdle) {
         run_gcode();
     } else if (w == Wait::DwellWhenIdle) {
-        p.dwell += hal::millis();
+        p.o.dwell_ms += hal::millis();
         p.wait = Wait::Dwell;
     } else if (w == Wait::PauseWhenIdle) {
         p.wait = Wait::Paused;

@@ -61,7 +61,6 @@ Result circle(double r, double feed, double accel, double entry, double exit, si
     c.b_um[0] = c.b_um[1] = static_cast<int32_t>(r * 1000);
     ll::CurveShape shape;
     EXPECT_TRUE(ll::curve_shape(c, 0, false, shape));
-    c.len_q8 = shape.len_q8;
     ll::MoveSpec spec = mach.move({0, 0}, feed, accel, entry, exit, 0x3);
     spec.len_q8 = shape.len_q8;
     spec.curve = &c;

@@ -43,7 +43,6 @@ struct CurveParams {
     int32_t end_um[2];   ///< end (u, v)
     int32_t a_um[2];     ///< arc: centre; Bezier: first control point
     int32_t b_um[2];     ///< arc: semi-axes along u, v (equal for a circle); Bezier: second one
-    uint32_t len_q8;     ///< path length, µm x 256 (set by the planner: curve_shape)
 };
 
 /// What the planner needs of a curve (seed §10.2: the length is what the acceleration and

@@ -15,9 +15,30 @@ struct LineRequest {
     uint32_t feed;               ///< F in units/min x1000; ignored when `rapid`
     bool rapid;                  ///< G0: as fast as every axis allows
     /// The curve from the current position to the target, or nullptr for a straight move.
-    /// Copied by push_line(); its len_q8 is computed there.
+    /// Copied by push_line().
     const CurveParams* curve;
 };
+
+/// Scratch RAM that the motion side uses only inside poll(), to hand the next move to the step
+/// generator. Outside poll() it is lent to the G-code layer, which keeps there its work block
+/// (gcode.cpp), live from gcode::execute() until push_line() has queued the move: push_line()
+/// only polls once the move is in the planner, and execute() never polls. Sharing it saves RAM
+/// on the deepest stack (the move handed over was a local of poll()).
+// The size of the G-code work block on the AVR (gcode.cpp checks it), generous on the host.
+constexpr uint16_t kScratchBytes =
+    sizeof(void*) == 2 ? 92 + 16 * kAxes + (kAxes > 5 ? 2 : 0) : 128 + 32 * kAxes;
+extern uint8_t g_scratch[kScratchBytes];
+/// The scratch RAM as a T. Each side only ever accesses it as its own type, in its own
+/// translation unit, and the other side's accesses are behind a call: no access through one
+/// type can be reordered across an access through the other (the -Wstrict-aliasing concern).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wstrict-aliasing"
+template <typename T>
+inline T& scratch() {
+    static_assert(sizeof(T) <= kScratchBytes, "fits the scratch RAM");
+    return *reinterpret_cast<T*>(g_scratch);
+}
+#pragma GCC diagnostic pop
 
 /// Power-up state: position zero, nothing queued, step timer stopped. Call once before
 /// settings_changed().

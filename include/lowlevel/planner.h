@@ -3,10 +3,11 @@
 // from, recomputed as moves arrive (backward then forward pass). Speeds are squared, in
 // (units/min)^2 of each move's regulated path (seed §3.1); integer only.
 //
-// A queued move costs 33 bytes of RAM (4 axes): deltas are kept on 24 bits, the group and the
-// curve slot share a byte; the length is kept (the step generator needs it when the move starts,
-// and recomputing it took a square root per move) and the acceleration is derived from dv2 and
-// the length instead of being stored.
+// A queued move costs 29 bytes of RAM (4 axes): deltas are kept on 24 bits, the group and the
+// curve slot share a byte; a line's length is recomputed from its deltas when the step generator
+// starts it (a square root per move, against 4 bytes per block: RAM is the limit), a curve's is
+// kept in its slot (it takes a quadrature); the acceleration is derived from dv2 and the length
+// instead of being stored.
 #pragma once
 
 #include "lowlevel/machine.h"
@@ -22,7 +23,6 @@ struct PlanBlock {
     uint8_t delta[kAxes][3]; ///< steps per machine axis, signed 24-bit little-endian
     uint8_t group : 6;       ///< regulated axes (seed §3.1)
     uint8_t curve : 2;       ///< 0: a straight move; else 1 + the slot of its curve
-    uint32_t len_q8;         ///< length of the regulated path, µm x 256 (for the step generator)
     // dv2, feed, v_entry2: in MoveSpec's order (spec_of_first() copies them at once).
     uint32_t dv2;          ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
     uint32_t feed;         ///< nominal speed, units/min x1000
@@ -60,11 +60,22 @@ class Planner {
     /// travels more than kMaxLineTicks.
     bool add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
              bool rapid);
-    /// Queues a curve (seed part IV) from the last target to `target` along `curve` (its
-    /// len_q8 is computed here): its length, its curvature limit (v^2 <= a r) and its end
-    /// tangents (for the junctions) come from curve_shape(). Returns false for a degenerate
-    /// curve. Precondition: curve_slot_free() and !full().
-    bool add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
+    /// Queues a curve (seed part IV) from the last target to `target` along `curve`, in two
+    /// calls, so that the deepest computation of the firmware does not stack on top of the
+    /// second one's frame. shape_curve(): the curve's length, curvature limit (v^2 <= a r) and end
+    /// tangents (for the junctions) from curve_shape(), kept in the free curve slot; false for a
+    /// degenerate curve (then nothing is queued, and add_curve() must not be called). Then
+    /// add_curve() with the same `target_um` and `curve`. Precondition: curve_slot_free() and
+    /// !full().
+    bool shape_curve(const int32_t target_um[kAxes], const CurveParams& curve) {
+        const uint8_t w = static_cast<uint8_t>(2 - curve.plane); // the normal axis
+        const bool w_regulated = regulates_w(curve.plane);
+        int32_t dw_um = 0;
+        if (w_regulated) dw_um = target_um[w] - last_um_[w];
+        CurveSlot* const s = free_slot_index() ? curves_ + 1 : curves_;
+        return curve_shape(curve, dw_um, w_regulated, s->shape);
+    }
+    void add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                    const CurveParams& curve);
     /// A curve needs one of kCurveSlots slots besides its block.
     bool curve_slot_free() const { return curve_used_ != (1u << kCurveSlots) - 1; }
@@ -72,7 +83,7 @@ class Planner {
     /// The i-th queued move (0 = oldest). Precondition: i < count().
     const PlanBlock& block(uint8_t i) const { return ring_[index(i)]; }
     /// The oldest move as the step generator needs it (entry and planned exit speeds).
-    MoveSpec spec_of_first() const;
+    void spec_of_first(MoveSpec& s) const;
     /// Planned exit speed squared of the oldest move (the next one's entry, 0 at the end).
     uint32_t exit2_of_first() const;
     /// The step generator started the oldest move: its entry speed is now fixed.
@@ -112,8 +123,30 @@ class Planner {
     /// Completes the block being queued (its deltas, curve and dv2 written): feed (at least 1),
     /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes. The
     /// caller then sets prev_unit_ to the direction it ends along.
-    void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed, uint32_t len_q8,
+    void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
                       const int32_t unit_in[kAxes]);
+
+    /// A curve's slot: its parameters and length while its move is queued; before that, while
+    /// the move is being queued, the curve's shape (shape_curve()).
+    struct CurveSlot {
+        union {
+            CurveParams params;
+            CurveShape shape;
+        };
+        uint32_t len_q8; ///< µm x 256
+    };
+    static_assert(sizeof(CurveShape) <= sizeof(CurveParams), "the shape costs no RAM");
+    /// The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
+    uint8_t free_slot_index() const {
+        static_assert(kCurveSlots == 2, "one free slot out of two");
+        return curve_used_ & 1;
+    }
+    /// True when the normal axis of `plane` is regulated with the plane's axes (it counts in a
+    /// curve's length).
+    bool regulates_w(uint8_t plane) const {
+        // The group of the plane's first machine axis (Y for G19, else X), and the normal axis.
+        return (m_->group_of[plane == 2 ? 1 : 0] & (4 >> plane)) != 0;
+    }
 
     // The small fields first: within 64 bytes of `this`, the ATmega328P reaches them with one
     // displacement instruction instead of an address computation.
@@ -125,7 +158,7 @@ class Planner {
     int32_t last_[kAxes];
     int32_t last_um_[kAxes];
     int32_t prev_unit_[kAxes]; ///< unit vector of the last move, Q29
-    CurveParams curves_[kCurveSlots];
+    CurveSlot curves_[kCurveSlots];
     PlanBlock ring_[kPlannerSize];
 };
 
