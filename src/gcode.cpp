@@ -418,12 +418,17 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
 __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t axes,
                                               const State& st, CurveParams& c) {
     uint8_t ax[3];
-    c.plane = b.g[kGroupPlane];
-    plane_axes(c.plane, ax);
+    const uint8_t plane = c.plane = b.g[kGroupPlane];
+    // plane_axes() as a rotation: (u, v, w) = axes (k - plane) mod 3.
+    for (uint8_t k = 0, a = static_cast<uint8_t>(plane ? 3 - plane : 0); k < 3; ++k) {
+        ax[k] = a;
+        a = a == 2 ? 0 : static_cast<uint8_t>(a + 1);
+    }
     const uint8_t u = ax[0], v = ax[1];
-    const uint8_t in_plane = static_cast<uint8_t>((1u << u) | (1u << v));
+    // The normal of plane p is axis 2 - p (plane_axes), so the plane's axes are X Y Z but it.
+    const uint8_t in_plane = static_cast<uint8_t>(7u ^ (4u >> plane));
     // A curve moves the plane's axes and, along a helix, the normal one: not the others.
-    if (axes & ~(in_plane | (1u << ax[2]))) return kAxisWordsExist;
+    if (axes & ~7u) return kAxisWordsExist;
     bool ellipse = motion == Motion::EllipseCw || motion == Motion::EllipseCcw;
     bool bezier = motion == Motion::Bezier;
     if (!ellipse && axes == 0) return kNoAxisWords;
@@ -447,7 +452,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     }
     int32_t d[2]; // end - start
     sub2(d, c.end_um, c.start_um);
-    bool has_offsets = (b.words & (bit(words[0]) | bit(words[1]))) != 0;
+    bool has_offsets = ((b.words >> kWordI) & in_plane) != 0; // I J K are X Y Z's offsets
     bool has_pq = (b.words & bit(kWordP)) && (b.words & bit(kWordQ));
     const WordMask ijk = bit(kWordI) | bit(kWordJ) | bit(kWordK);
     WordMask used = static_cast<WordMask>(ijk | bit(kWordP) | bit(kWordQ)); // G2.1, G3.1, G5
