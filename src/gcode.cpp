@@ -354,46 +354,36 @@ __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
     return sum_squares(v, 2).sqrt();
 }
 
-// How far (um, the larger of the two coordinates) the point p is from the point of the ellipse
-// of semi-axes `radii` centred on `centre` that has the same direction in the ellipse's own
-// scale (ellipse_direction): within a tick of it is on the ellipse. (A point so far out that the
-// difference wraps is refused by the range check anyway.)
-__attribute__((noinline)) uint32_t ellipse_gap_um(const int32_t p[2], const int32_t centre[2],
-                                                  const uint32_t radii[2]) {
-    int32_t xy[2], cs[2];
-    sub2(xy, p, centre);
-    ellipse_direction(xy[0], xy[1], radii, cs[0], cs[1]);
-    uint32_t gap = 0;
-    for (uint8_t k = 0; k < 2; ++k) {
-        uint32_t on = Num(radii[k]).mul(abs32(cs[k])).shift(-30).u32();
-        uint32_t d = static_cast<uint32_t>(xy[k]) - (cs[k] < 0 ? 0u - on : on);
-        d = abs32(static_cast<int32_t>(d));
-        if (d > gap) gap = d;
-    }
-    return gap;
-}
-
 // The step generator's fixed-point range (docs/curves.md): the ends, the control points or the
 // centre, and the semi-axes, within 2^22 steps; the length within 2^23 um (an arc's is at most
 // its larger semi-axis times its sweep; a Bezier's at most its control polygon's), and the
-// normal axis' travel `dw_um` too. (A function of its own: a small stack frame.)
+// normal axis' travel `dw_um` too. An arc's ends must also be on its ellipse within `gap_um`:
+// each coordinate within gap_um of the ellipse's point that has the same direction in the
+// ellipse's own scale (ellipse_direction). (A function of its own: a small stack frame.)
 __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_t ax[3],
-                                              int32_t dw_um) {
-    Num reach{};                                                          // length bound, um
-    const int32_t* const pts[4] = {c.start_um, c.a_um, c.b_um, c.end_um}; // a G5's polygon
-    for (uint8_t i = 0; i < 4; ++i) {
-        for (uint8_t k = 0; k < 2; ++k) {
-            int32_t steps;
-            if (!num::mul_div_round(pts[i][k], g_settings.axis[ax[k]].steps_per_unit, 1000000u,
-                                    steps) ||
-                abs32(steps) > (1l << 22)) {
-                return false;
-            }
+                                              int32_t dw_um, uint32_t gap_um) {
+    static_assert(offsetof(CurveParams, end_um) == offsetof(CurveParams, start_um) + 8 &&
+                      offsetof(CurveParams, a_um) == offsetof(CurveParams, start_um) + 16 &&
+                      offsetof(CurveParams, b_um) == offsetof(CurveParams, start_um) + 24,
+                  "start, end, a, b: four points in a row");
+    const int32_t(*pts)[2] = reinterpret_cast<const int32_t(*)[2]>(c.start_um);
+    for (uint8_t i = 0; i < 8; ++i) {
+        int32_t steps;
+        if (!num::mul_div_round(pts[0][i], g_settings.axis[ax[i & 1]].steps_per_unit, 1000000u,
+                                steps) ||
+            abs32(steps) > (1l << 22)) {
+            return false;
         }
-        if (i != 0 && c.kind == kCurveBezier) {
+    }
+    Num reach{}; // length bound, um
+    if (c.kind == kCurveBezier) {
+        // The control polygon start, a, b, end: points 0 2 3 1 of the row, 2 bits each.
+        for (uint8_t seq = 0x1E, prev = 0; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
+            uint8_t i = seq & 3;
             int32_t d[2];
-            sub2(d, pts[i], pts[i - 1]);
+            sub2(d, pts[i], pts[prev]);
             reach.add(Num(abs32(d[0]))).add(Num(abs32(d[1])));
+            prev = i;
         }
     }
     if (c.kind == kCurveArc) {
@@ -402,7 +392,13 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
         for (uint8_t e = 0; e < 2; ++e) {
             int32_t p[2];
             sub2(p, e ? c.end_um : c.start_um, c.a_um);
-            ellipse_direction(p[0], p[1], radii, cs[2 * e], cs[2 * e + 1]);
+            int32_t* cse = &cs[2 * e];
+            ellipse_direction(p[0], p[1], radii, cse[0], cse[1]);
+            for (uint8_t k = 0; k < 2; ++k) {
+                uint32_t on = Num(radii[k]).mul(abs32(cse[k])).shift(-30).u32();
+                uint32_t d = static_cast<uint32_t>(p[k]) - (cse[k] < 0 ? 0u - on : on);
+                if (abs32(static_cast<int32_t>(d)) > gap_um) return false;
+            }
         }
         int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], c.clockwise != 0, c.turns);
         // |sweep| < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r |sweep|.
@@ -510,14 +506,11 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         c.a_um[k] = add(c.start_um[k], o[k]);
         c.b_um[k] = bezier ? add(c.end_um[k], o[k + 2]) : o[k + 2];
     }
+    uint32_t gap = 0xFFFFFFFFu; // a circle's ends are checked here
     if (ellipse) {
-        const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
+        // Both ends on the ellipse within the larger step + 2 um (in curve_in_range()).
         uint32_t spu = g_settings.axis[u].steps_per_unit, spv = g_settings.axis[v].steps_per_unit;
-        uint32_t tol = 1000000ul / (spu < spv ? spu : spv) + 2; // the larger step + 2 um
-        if (ellipse_gap_um(c.start_um, c.a_um, radii) > tol ||
-            ellipse_gap_um(c.end_um, c.a_um, radii) > tol) {
-            return kInvalidTarget;
-        }
+        gap = 1000000ul / (spu < spv ? spu : spv) + 2;
     } else if (!bezier) {
         if (!(b.words & bit(kWordR))) {
             // The end must be on the circle: within 0.005 mm, or else within 0.5 mm and 0.1 %.
@@ -537,7 +530,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             c.turns = static_cast<uint8_t>(turns - 1);
         }
     }
-    if (!curve_in_range(c, ax, add(w.req.target_um[ax[2]], st.position[ax[2]], true))) {
+    if (!curve_in_range(c, ax, add(w.req.target_um[ax[2]], st.position[ax[2]], true), gap)) {
         return kInvalidTarget;
     }
     if (b.overflow) return kInvalidTarget;
