@@ -366,10 +366,10 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
                       offsetof(CurveParams, a_um) == offsetof(CurveParams, start_um) + 16 &&
                       offsetof(CurveParams, b_um) == offsetof(CurveParams, start_um) + 24,
                   "start, end, a, b: four points in a row");
-    const int32_t(*pts)[2] = reinterpret_cast<const int32_t(*)[2]>(c.start_um);
+    const int32_t* const row = c.start_um; // (a pointer: indexing the array past 2 is undefined)
     for (uint8_t i = 0; i < 8; ++i) {
         int32_t steps;
-        if (!num::mul_div_round(pts[0][i], g_settings.axis[ax[i & 1]].steps_per_unit, 1000000u,
+        if (!num::mul_div_round(row[i], g_settings.axis[ax[i & 1]].steps_per_unit, 1000000u,
                                 steps) ||
             abs32(steps) > (1l << 22)) {
             return false;
@@ -381,7 +381,7 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
         for (uint8_t seq = 0x1E, prev = 0; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
             uint8_t i = seq & 3;
             int32_t d[2];
-            sub2(d, pts[i], pts[prev]);
+            sub2(d, row + 2 * i, row + 2 * prev);
             reach.add(Num(abs32(d[0]))).add(Num(abs32(d[1])));
             prev = i;
         }
@@ -432,8 +432,9 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     c.kind = bezier ? kCurveBezier : kCurveArc;
     c.clockwise = motion == Motion::ArcCw || motion == Motion::EllipseCw;
     c.turns = 0;
-    // o: the plane's offsets (I J, I K or J K), then P and Q, in um.
-    int32_t o[4];
+    // o: the plane's offsets (I J, I K or J K), then P and Q, in um; kept in c.a_um and c.b_um
+    // (a row of 4: checked in curve_in_range) until they become the points.
+    int32_t* const o = c.a_um;
     const uint8_t words[4] = {static_cast<uint8_t>(kWordI + u), static_cast<uint8_t>(kWordI + v),
                               kWordP, kWordQ};
     for (uint8_t k = 0; k < 4; ++k) {
@@ -502,9 +503,10 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             used = static_cast<WordMask>(used | ijk);
         }
     }
-    for (uint8_t k = 0; k < 2; ++k) {
-        c.a_um[k] = add(c.start_um[k], o[k]);
-        c.b_um[k] = bezier ? add(c.end_um[k], o[k + 2]) : o[k + 2];
+    // a = start + the offsets; a G5's b = end + P Q (start, end: a row of 4 too).
+    const int32_t* const ends = c.start_um;
+    for (uint8_t k = 0; k < 4; ++k) {
+        if (k < 2 || bezier) o[k] = add(ends[k], o[k]);
     }
     uint32_t gap = 0xFFFFFFFFu; // a circle's ends are checked here
     if (ellipse) {
