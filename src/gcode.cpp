@@ -435,13 +435,10 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     // o: the plane's offsets (I J, I K or J K), then P and Q, in um; kept in c.a_um and c.b_um
     // (a row of 4: checked in curve_in_range) until they become the points.
     int32_t* const o = c.a_um;
-    const uint8_t words[4] = {static_cast<uint8_t>(kWordI + u), static_cast<uint8_t>(kWordI + v),
-                              kWordP, kWordQ};
     for (uint8_t k = 0; k < 4; ++k) {
+        uint8_t word = static_cast<uint8_t>(k < 2 ? kWordI + ax[k] : k == 2 ? kWordP : kWordQ);
         o[k] = 0;
-        if ((b.words & bit(words[k])) && !length(b.v[words[k]].d, o[k])) {
-            return kBadNumberFormat;
-        }
+        if ((b.words & bit(word)) && !length(b.v[word].d, o[k])) return kBadNumberFormat;
         if (k < 2) {
             c.start_um[k] = st.position[ax[k]];
             c.end_um[k] = w.req.target_um[ax[k]];
@@ -480,8 +477,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             // Centre on the perpendicular bisector: h = -sqrt(4 r^2 - d^2) / d, negated for
             // G3 and for a negative R (the longer arc).
             r = abs32(rw);
-            const int32_t zero[2] = {0, 0};
-            Num dn = dist_um(d, zero);
+            Num dn = dist_um(c.end_um, c.start_um); // |d|
             Num r2(r);
             r2.mul(r2).mul(4u);
             Num d2 = dn;
