@@ -473,11 +473,11 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             used = static_cast<WordMask>(used | bit(kWordR)); // I J K stay unused (GRBL: 36)
             int32_t rw;
             if (!length(b.v[kWordR].d, rw)) return kBadNumberFormat;
-            if (d[0] == 0 && d[1] == 0) return kInvalidTarget;
+            Num dn = dist_um(c.end_um, c.start_um); // |d|
+            if (dn.m == 0) return kInvalidTarget;   // start = end
             // Centre on the perpendicular bisector: h = -sqrt(4 r^2 - d^2) / d, negated for
             // G3 and for a negative R (the longer arc).
             r = abs32(rw);
-            Num dn = dist_um(c.end_um, c.start_um); // |d|
             Num r2(r);
             r2.mul(r2).mul(4u);
             Num d2 = dn;
@@ -485,13 +485,15 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             if (r2.cmp(d2) < 0) return kArcRadiusError;
             uint32_t rr = r2.shift(-16).u32(), dd = d2.shift(-16).u32(); // both below 2^32
             Num h(rr - dd, 16);
-            h.sqrt().div(dn);                                     // |h|
-            bool neg = !((motion == Motion::ArcCcw) != (rw < 0)); // -sqrt(..), flipped
+            h.sqrt().div(dn); // |h|
+            // -sqrt(..), flipped for G3 and R < 0, and for u: x - y h = x + y (-h).
+            bool neg = (motion == Motion::ArcCcw) != (rw < 0);
             // o = (d - h (d1, -d0)) / 2: (x - y h) / 2, (y + x h) / 2.
             for (uint8_t k = 0; k < 2; ++k) {
                 int32_t t = static_cast<int32_t>(h.of(abs32(d[1 - k])));
                 if ((d[1 - k] < 0) != neg) t = -t;
-                o[k] = (k == 0 ? d[0] - t : d[1] + t) / 2;
+                o[k] = (d[k] + t) / 2;
+                neg = !neg;
             }
         } else if (!has_offsets) {
             return kNoOffsetsInPlane;
