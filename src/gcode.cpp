@@ -357,24 +357,27 @@ __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
 // The step generator's fixed-point range (docs/curves.md): the ends, the control points or the
 // centre, and the semi-axes, within 2^22 steps; the length within 2^23 um (an arc's is at most
 // its larger semi-axis times its sweep; a Bezier's at most its control polygon's), and the
-// normal axis' travel `dw_um` too. An arc's ends must also be on its ellipse within `gap_um`:
-// each coordinate within gap_um of the ellipse's point that has the same direction in the
+// normal axis' travel too. An ellipse's ends must also be on it within the larger step + 2 um:
+// each coordinate that close to the ellipse's point that has the same direction in the
 // ellipse's own scale (ellipse_direction). (A function of its own: a small stack frame.)
 __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_t ax[3],
-                                              int32_t dw_um, uint32_t gap_um) {
+                                              bool ellipse) {
     static_assert(offsetof(CurveParams, end_um) == offsetof(CurveParams, start_um) + 8 &&
                       offsetof(CurveParams, a_um) == offsetof(CurveParams, start_um) + 16 &&
                       offsetof(CurveParams, b_um) == offsetof(CurveParams, start_um) + 24,
                   "start, end, a, b: four points in a row");
     const int32_t* const row = c.start_um; // (a pointer: indexing the array past 2 is undefined)
+    uint32_t spu_min = 0xFFFFFFFFu;
     for (uint8_t i = 0; i < 8; ++i) {
         int32_t steps;
-        if (!num::mul_div_round(row[i], g_settings.axis[ax[i & 1]].steps_per_unit, 1000000u,
-                                steps) ||
-            abs32(steps) > (1l << 22)) {
+        uint32_t spu = g_settings.axis[ax[i & 1]].steps_per_unit;
+        if (spu < spu_min) spu_min = spu;
+        if (!num::mul_div_round(row[i], spu, 1000000u, steps) || abs32(steps) > (1l << 22)) {
             return false;
         }
     }
+    // A circle's ends are checked in check_curve().
+    uint32_t gap_um = ellipse ? 1000000ul / spu_min + 2 : 0xFFFFFFFFu;
     Num reach{}; // length bound, um
     if (c.kind == kCurveBezier) {
         // The control polygon start, a, b, end: points 0 2 3 1 of the row, 2 bits each.
@@ -385,13 +388,12 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
             reach.add(Num(abs32(d[0]))).add(Num(abs32(d[1])));
             prev = i;
         }
-    }
-    if (c.kind == kCurveArc) {
+    } else {
         const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
         int32_t cs[4];
         for (uint8_t e = 0; e < 2; ++e) {
             int32_t p[2];
-            sub2(p, e ? c.end_um : c.start_um, c.a_um);
+            sub2(p, row + 2 * e, c.a_um);
             int32_t* cse = &cs[2 * e];
             ellipse_direction(p[0], p[1], radii, cse[0], cse[1]);
             for (uint8_t k = 0; k < 2; ++k) {
@@ -405,7 +407,7 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
         uint32_t q21 = static_cast<uint32_t>((sweep < 0 ? -sweep : sweep) >> 8);
         reach.set(radii[0] > radii[1] ? radii[0] : radii[1]).mul(Num(q21, -21));
     }
-    reach.add(Num(abs32(dw_um)));
+    reach.add(Num(abs32(add(w.req.target_um[ax[2]], g_state.position[ax[2]], true))));
     return reach.cmp(Num(1, 23)) < 0;
 }
 
@@ -420,7 +422,6 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         ax[k] = a;
         a = a == 2 ? 0 : static_cast<uint8_t>(a + 1);
     }
-    const uint8_t u = ax[0], v = ax[1];
     // The normal of plane p is axis 2 - p (plane_axes), so the plane's axes are X Y Z but it.
     const uint8_t in_plane = static_cast<uint8_t>(7u ^ (4u >> plane));
     // A curve moves the plane's axes and, along a helix, the normal one: not the others.
@@ -506,12 +507,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     for (uint8_t k = 0; k < 4; ++k) {
         if (k < 2 || bezier) o[k] = add(ends[k], o[k]);
     }
-    uint32_t gap = 0xFFFFFFFFu; // a circle's ends are checked here
-    if (ellipse) {
-        // Both ends on the ellipse within the larger step + 2 um (in curve_in_range()).
-        uint32_t spu = g_settings.axis[u].steps_per_unit, spv = g_settings.axis[v].steps_per_unit;
-        gap = 1000000ul / (spu < spv ? spu : spv) + 2;
-    } else if (!bezier) {
+    // (An ellipse's ends are checked in curve_in_range().)
+    if (!ellipse && !bezier) {
         if (!(b.words & bit(kWordR))) {
             // The end must be on the circle: within 0.005 mm, or else within 0.5 mm and 0.1 %.
             Num rn = dist_um(c.start_um, c.a_um);
@@ -530,10 +527,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             c.turns = static_cast<uint8_t>(turns - 1);
         }
     }
-    if (!curve_in_range(c, ax, add(w.req.target_um[ax[2]], st.position[ax[2]], true), gap)) {
-        return kInvalidTarget;
-    }
-    if (b.overflow) return kInvalidTarget;
+    if (!curve_in_range(c, ax, ellipse) || b.overflow) return kInvalidTarget;
     b.words = static_cast<WordMask>(b.words & ~used);
     return kOk;
 }
