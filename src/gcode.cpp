@@ -629,7 +629,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     };
     bool offsets = non_modal == kSetCoordData || non_modal == kSetOffset;
     const int32_t* keep = st.position;
-    const int32_t* other = st.g54;
+    uint8_t other = 2 * kAxes; // the other offset for kFromPosition: g54 (below), or g92
     uint8_t op = non_modal == kAbsoluteOverride ? kAsIs
                  : b.g[kGroupDistance]          ? kPlusPosition
                                                 : kPlusOffsets;
@@ -650,34 +650,42 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
             }
             b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
             keep = st.g54;
-            other = st.g92;
+            other = 3 * kAxes;
         }
     } else if (non_modal == kAbsoluteOverride && motion > Motion::Linear) {
         return kG53InvalidMotionMode;
     }
     motion::LineRequest& req = w.req;
+    static_assert(offsetof(State, position_steps) == offsetof(State, position) + 4 * kAxes &&
+                      offsetof(State, g54) == offsetof(State, position) + 8 * kAxes &&
+                      offsetof(State, g92) == offsetof(State, position) + 12 * kAxes &&
+                      offsetof(motion::LineRequest, target_um) ==
+                          offsetof(motion::LineRequest, target_steps) + 4 * kAxes,
+                  "the arrays of axes in a row");
     if (offsets || b.axis_command == kAxisMotion) {
         copy_words(req.target_um, keep, kAxes); // for G10 / G92: the new offsets
         copy_words(req.target_steps, st.position_steps, kAxes);
         for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
             if (!(m & 1)) continue;
+            // Axis a of the arrays in a row: st's position (+ kAxes: position_steps, + 2 kAxes:
+            // g54, + 3 kAxes: g92) and req's target_steps (+ kAxes: target_um).
+            const int32_t* const sa = st.position + a;
+            int32_t* const ra = req.target_steps + a;
             int32_t t = b.v[a].um;
             if (op == kPlusPosition) {
-                t = add(t, st.position[a]);
+                t = add(t, sa[0]);
             } else if (op == kPlusOffsets) {
-                t = add(add(t, st.g54[a]), st.g92[a]);
+                t = add(add(t, sa[2 * kAxes]), sa[3 * kAxes]);
             } else if (op == kFromPosition) {
-                t = add(add(st.position[a], other[a], true), t, true);
+                t = add(add(sa[0], sa[other], true), t, true);
             }
-            req.target_um[a] = t;
+            ra[kAxes] = t;
             // Always from the absolute target: no rounding error accumulates. One move travels
             // at most kMaxLineTicks steps per axis (line.h).
-            int32_t& steps = req.target_steps[a];
             if (!offsets &&
-                (!num::mul_div_round(t, g_settings.axis[a].steps_per_unit, 1000000u, steps) ||
-                 abs32(static_cast<int32_t>(static_cast<uint32_t>(steps) -
-                                            static_cast<uint32_t>(st.position_steps[a]))) >
-                     kMaxLineTicks)) {
+                (!num::mul_div_round(t, g_settings.axis[a].steps_per_unit, 1000000u, ra[0]) ||
+                 abs32(static_cast<int32_t>(static_cast<uint32_t>(ra[0]) -
+                                            static_cast<uint32_t>(sa[kAxes]))) > kMaxLineTicks)) {
                 b.overflow = 1;
             }
         }
