@@ -312,8 +312,8 @@ __attribute__((noinline)) bool length(const num::Decimal& d, int32_t& out) {
 // error:33). Bit 31 of (a ^ r) & (b' ^ r) is the signed overflow of r = a + b'.
 __attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = false) {
     uint32_t ua = static_cast<uint32_t>(a), ub = static_cast<uint32_t>(b);
-    uint32_t r = subtract ? ua - ub : ua + ub;
-    if (subtract) ub = ~ub; // a - b overflows as a + ~b would (the sign of -b is ~b's)
+    if (subtract) ub = ~ub; // a - b = a + ~b + 1, and overflows as a + ~b would
+    uint32_t r = ua + ub + subtract;
     if (((ua ^ r) & (ub ^ r)) >> 31) w.b.overflow = 1;
     return static_cast<int32_t>(r);
 }
