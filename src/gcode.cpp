@@ -458,15 +458,16 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         if (!has_pq) return kValueWordMissing;
         if (!has_offsets) {
             if (!st.g5_continues) return kValueWordMissing;
-            o[0] = st.g5_reflect[0];
-            o[1] = st.g5_reflect[1];
+            copy_words(o, st.g5_reflect, 2);
         }
     } else if (ellipse) {
         // G2.1 / G3.1: I J the centre from the start, P Q the semi-axes along the plane's
         // axes; both ends on the ellipse within one tick + 0.002 mm (checked below).
         if (!has_offsets) return kNoOffsetsInPlane;
         if (!has_pq) return kValueWordMissing;
-        if (o[2] <= 0 || o[3] <= 0) return kNegativeValue;
+        for (uint8_t k = 2; k < 4; ++k) {
+            if (o[k] <= 0) return kNegativeValue;
+        }
     } else {
         // G2 / G3, as GRBL: radius mode (R) or centre mode (the plane's offsets).
         used = bit(kWordP);
@@ -488,7 +489,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             Num h(rr - dd, 16);
             h.sqrt().div(dn); // |h|
             // -sqrt(..), flipped for G3 and R < 0, and for u: x - y h = x + y (-h).
-            bool neg = (motion == Motion::ArcCcw) != (rw < 0);
+            // (R's sign: rw != 0 here, else r2 < d2 above.)
+            bool neg = (motion == Motion::ArcCcw) != b.v[kWordR].d.negative();
             // o = (d - h (d1, -d0)) / 2: (x - y h) / 2, (y + x h) / 2.
             for (uint8_t k = 0; k < 2; ++k) {
                 int32_t t = static_cast<int32_t>(h.of(abs32(d[1 - k])));

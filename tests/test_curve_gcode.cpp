@@ -127,6 +127,10 @@ TEST_F(Curves, BadArcsGetGrblsErrorCodes) {
     EXPECT_EQ(run("G2.1 X10 I5 J0 P4 Q3 F600"), "error:33\r\n");
     EXPECT_EQ(run("G2.1 X10 I5 J0 F600"), "error:28\r\n");
     EXPECT_EQ(run("G2.1 X10 P5 Q3 F600"), "error:35\r\n");
+    // Values that round to zero: an R0 (too short, whatever its sign), a semi-axis 0.
+    EXPECT_EQ(run("G2 X10 R-0.0001 F600"), "error:34\r\n");
+    EXPECT_EQ(run("G2.1 X10 I5 J0 P-5 Q3 F600"), "error:4\r\n");
+    EXPECT_EQ(run("G2.1 X10 I5 J0 P5 Q0.0001 F600"), "error:4\r\n");
     // G5: P Q required; I J required unless it continues a G5.
     EXPECT_EQ(run("G5 X10 I1 J1 F600"), "error:28\r\n");
     EXPECT_EQ(run("G5 X10 P-1 Q1 F600"), "error:28\r\n");
