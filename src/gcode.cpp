@@ -142,6 +142,7 @@ enum Word : uint8_t {
     kWordT,
     kWordCount
 };
+static_assert(kWordS > kWordN && kWordT == kWordCount - 1, "N L S T last");
 constexpr uint8_t kDecimalSlots = kWordR + 1;
 constexpr uint8_t kLetterG = 0xFD, kLetterM = 0xFE, kLetterNone = 0xFF;
 
@@ -284,8 +285,10 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
     if (d.negative() && (wbit & kNotNegative)) return kNegativeValue;
     b.words |= wbit;
     if (word == kWordS) {
-        b.s = d.ipart + (d.frac >= 500 ? 1u : 0u);
-    } else if (word >= kWordN && word <= kWordT) {
+        uint32_t v = d.ipart;
+        if (d.frac >= 500) ++v; // rounded half up
+        b.s = v;
+    } else if (word >= kWordN) { // N L T (the last words)
         // N 0..10000000 and L 0..254 (else checked in stage 3), T 0..255.
         uint32_t v;
         if (!num::to_uint(d, word == kWordN ? 10000000u : word == kWordL ? 254u : 255u, v)) {
