@@ -231,13 +231,14 @@ struct Work {
 };
 Work w;
 
-// The first decimal of a command number (G92.1 -> 1), or 0xFF with a finer fraction (G1.05).
+// The first decimal of a command number (G92.1 -> 1) in the high nibble, as in Command::group,
+// or 0xFF with a finer fraction (G1.05).
 uint8_t tenths(const num::Decimal& d) {
     if (d.sub != 0 || (d.frac != 0 && (d.flags & num::Decimal::kInexact) != 0)) return 0xFF;
     uint8_t t = 0;
     for (uint16_t f = d.frac; f != 0; f = static_cast<uint16_t>(f - 100u)) {
         if (f < 100) return 0xFF;
-        ++t;
+        t = static_cast<uint8_t>(t + 0x10);
     }
     return t;
 }
@@ -249,7 +250,6 @@ uint8_t import_command(Block& b, uint8_t m, const num::Decimal& d) {
     if (d.negative() || d.ipart > 127) return kUnsupportedCommand;
     uint8_t key = static_cast<uint8_t>(d.ipart | m);
     uint8_t dec = tenths(d);
-    if (dec != 0xFF) dec = static_cast<uint8_t>(dec << 4); // as in Command::group
     const Command* c = nullptr;
     bool found = false;
     const Command* e = kCommands;
