@@ -231,6 +231,16 @@ struct Work {
 };
 Work w;
 
+// x through a pointer the compiler cannot see through: its fields are then read and written with
+// a displacement from a pointer register (2 bytes an instruction), not at absolute addresses
+// (lds/sts, 4 bytes).
+template <typename T>
+T& opaque(T& x) {
+    T* p = &x;
+    asm("" : "+r"(p));
+    return *p;
+}
+
 // The first decimal of a command number (G92.1 -> 1) in the high nibble, as in Command::group,
 // or 0xFF with a finer fraction (G1.05).
 uint8_t tenths(const num::Decimal& d) {
@@ -546,7 +556,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     outcome.dwell_ms = 0;
 
     // ---- Stage 1: a block that starts from the current modes.
-    Block& b = w.b;
+    Block& b = opaque(w.b);
     static_assert(offsetof(State, tool) == sizeof(Modal) && sizeof(Modal) + 1 == 8,
                   "modal and tool are two words");
     b.g[kGroupNonModal] = kNoNonModal;
@@ -704,7 +714,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     } else if (b.axis_command == kAxisMotion) {
         if (motion != Motion::Seek && b.feed == 0) return kUndefinedFeedRate;
         if (motion >= Motion::ArcCw && motion <= Motion::Bezier) {
-            uint8_t r = check_curve(b, motion, axes, st, b.curve);
+            uint8_t r = check_curve(w.b, motion, axes, st, w.b.curve); // (at fixed addresses)
             if (r != kOk) return r;
             curve = true;
         } else if (axes == 0) {
