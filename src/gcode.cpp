@@ -410,7 +410,7 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
             int32_t* cse = &cs[2 * e];
             ellipse_direction(p[0], p[1], radii, cse[0], cse[1]);
             for (uint8_t k = 0; k < 2; ++k) {
-                uint32_t on = Num(radii[k]).mul(abs32(cse[k])).shift(-30).u32();
+                uint32_t on = Num(abs32(cse[k]), -30).mul(radii[k]).u32(); // r |cs| (Q30)
                 uint32_t d = static_cast<uint32_t>(p[k]) - (cse[k] < 0 ? 0u - on : on);
                 if (abs32(static_cast<int32_t>(d)) > gap_um) return false;
             }
@@ -418,7 +418,7 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
         int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], c.clockwise != 0, c.turns);
         // |sweep| < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r |sweep|.
         uint32_t q21 = static_cast<uint32_t>((sweep < 0 ? -sweep : sweep) >> 8);
-        reach.set(radii[0] > radii[1] ? radii[0] : radii[1]).mul(Num(q21, -21));
+        reach.set(q21, -21).mul(radii[0] > radii[1] ? radii[0] : radii[1]);
     }
     reach.add(Num(abs32(add(w.req.target_um[ax[2]], g_state.position[ax[2]], true))));
     return reach.cmp(Num(1, 23)) < 0;
