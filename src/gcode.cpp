@@ -361,9 +361,10 @@ __attribute__((noinline)) void sub2(int32_t out[2], const int32_t p[2], const in
 
 // |p - q| for two points of the plane, um.
 __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
-    int32_t d[2];
+    uint32_t v[2];
+    int32_t* d = reinterpret_cast<int32_t*>(v);
     sub2(d, p, q);
-    uint32_t v[2] = {abs32(d[0]), abs32(d[1])};
+    for (uint8_t k = 0; k < 2; ++k) v[k] = abs32(d[k]);
     return sum_squares(v, 2).sqrt();
 }
 
