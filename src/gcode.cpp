@@ -791,8 +791,9 @@ bool reset() {
 }
 
 void steps_to_um(const int32_t* steps, int32_t* um) {
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        num::mul_div_round(steps[a], 1000000u, g_settings.axis[a].steps_per_unit, um[a]);
+    const AxisSettings* s = g_settings.axis;
+    for (uint8_t a = kAxes; a != 0; --a) {
+        num::mul_div_round(*steps++, 1000000u, (s++)->steps_per_unit, *um++);
     }
 }
 
