@@ -316,9 +316,10 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
     return kOk;
 }
 
-// A length word in the units of the block, to um (or a feed to mm/min x1000).
-__attribute__((noinline)) bool length(const num::Decimal& d, int32_t& out) {
-    return num::length_to_milli(d, w.b.g[kGroupUnits] != 0, out);
+// The length word `word` of the block (its slot), in the units of the block, to um (or a feed to
+// mm/min x1000).
+__attribute__((noinline)) bool length(uint8_t word, int32_t& out) {
+    return num::length_to_milli(w.b.v[word].d, w.b.g[kGroupUnits] != 0, out);
 }
 
 // a + b, or a - b with `subtract`; an overflow sets Block::overflow (checked once per line:
@@ -453,7 +454,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     for (uint8_t k = 0; k < 4; ++k) {
         uint8_t word = static_cast<uint8_t>(k < 2 ? kWordI + ax[k] : k == 2 ? kWordP : kWordQ);
         o[k] = 0;
-        if ((b.words & bit(word)) && !length(b.v[word].d, o[k])) return kBadNumberFormat;
+        if ((b.words & bit(word)) && !length(word, o[k])) return kBadNumberFormat;
         if (k < 2) {
             c.start_um[k] = st.position[ax[k]];
             c.end_um[k] = w.req.target_um[ax[k]];
@@ -488,7 +489,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         if (b.words & bit(kWordR)) {
             used = static_cast<WordMask>(used | bit(kWordR)); // I J K stay unused (GRBL: 36)
             int32_t rw;
-            if (!length(b.v[kWordR].d, rw)) return kBadNumberFormat;
+            if (!length(kWordR, rw)) return kBadNumberFormat;
             Num dn = dist_um(c.end_um, c.start_um); // |d|
             if (dn.m == 0) return kInvalidTarget;   // start = end
             // Centre on the perpendicular bisector: h = -sqrt(4 r^2 - d^2) / d, negated for
@@ -612,7 +613,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
     if (b.words & bit(kWordF)) {
         int32_t f;
-        if (!length(b.v[kWordF].d, f)) return kBadNumberFormat;
+        if (!length(kWordF, f)) return kBadNumberFormat;
         b.feed = static_cast<uint32_t>(f);
     }
 
@@ -631,7 +632,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
         if (!(m & 1)) continue;
         int32_t um;
-        if (!length(b.v[a].d, um)) return kBadNumberFormat;
+        if (!length(a, um)) return kBadNumberFormat;
         b.v[a].um = um;
     }
     // One pass over the axes computes either the new offsets (G10, G92) or the target of a
