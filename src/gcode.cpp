@@ -532,7 +532,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             r = rn.u32();
             Num re = dist_um(c.end_um, c.a_um);
             uint32_t x = re.u32(), delta = x > r ? x - r : r - x;
-            if (delta > 5 && (delta > 500 || delta > r / 1000)) return kInvalidTarget;
+            // (delta > r / 1000 as delta * 1000 > r: the same for integers, delta <= 500.)
+            if (delta > 5 && (delta > 500 || delta * 1000u > r)) return kInvalidTarget;
         }
         if (r == 0) return kInvalidTarget;
         c.b_um[0] = static_cast<int32_t>(r);
