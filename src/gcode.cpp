@@ -496,7 +496,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             // G3 and for a negative R (the longer arc).
             r = abs32(rw);
             Num r2(r);
-            r2.mul(r2).mul(4u);
+            r2.mul(r2).shift(2); // 4 r^2
             Num d2 = dn;
             d2.mul(dn);
             if (r2.cmp(d2) < 0) return kArcRadiusError;
