@@ -423,7 +423,7 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
         reach.set(q21, -21).mul(radii[0] > radii[1] ? radii[0] : radii[1]);
     }
     reach.add(Num(abs32(add(w.req.target_um[ax[2]], g_state.position[ax[2]], true))));
-    return reach.cmp(Num(1, 23)) < 0;
+    return reach.u32() < (1ul << 23); // (floor(x) < 2^23 exactly when x < 2^23)
 }
 
 // Stage 3 of a curve (docs/curves.md): the checks and errors of GRBL's arcs (26 32 33 34 35), our
