@@ -598,10 +598,10 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     uint8_t axes = static_cast<uint8_t>(b.words & kAxisWords);
     // [0] Axis words without a command that uses them: the current motion mode does; so do the
     // words of an ellipse without an end point (a full ellipse, docs/curves.md).
-    if (axes != 0 && b.axis_command == kAxisNone) b.axis_command = kAxisMotion;
     bool ellipse = motion == Motion::EllipseCw || motion == Motion::EllipseCcw;
-    if (ellipse && b.axis_command == kAxisNone &&
-        (b.words & (bit(kWordI) | bit(kWordJ) | bit(kWordK) | bit(kWordP) | bit(kWordQ)))) {
+    if (b.axis_command == kAxisNone &&
+        (axes != 0 || (ellipse && (b.words & (bit(kWordI) | bit(kWordJ) | bit(kWordK) |
+                                              bit(kWordP) | bit(kWordQ)))))) {
         b.axis_command = kAxisMotion;
     }
     // P: negative only as a G5 control point offset (GRBL refuses a negative P as error:4).
