@@ -477,7 +477,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         }
     } else if (ellipse) {
         // G2.1 / G3.1: I J the centre from the start, P Q the semi-axes along the plane's
-        // axes; both ends on the ellipse within one tick + 0.002 mm (checked below).
+        // axes; both ends on the ellipse within one tick + 0.002 mm (in curve_in_range()).
         if (!has_offsets) return kNoOffsetsInPlane;
         if (!has_pq) return kValueWordMissing;
         for (uint8_t k = 2; k < 4; ++k) {
