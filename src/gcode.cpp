@@ -142,6 +142,7 @@ enum Word : uint8_t {
     kWordT,
     kWordCount
 };
+static_assert(kWordS > kWordN && kWordT == kWordCount - 1, "N L S T last");
 constexpr uint8_t kDecimalSlots = kWordR + 1;
 constexpr uint8_t kLetterG = 0xFD, kLetterM = 0xFE, kLetterNone = 0xFF;
 
@@ -235,13 +236,24 @@ inline Work& work() {
     return motion::scratch<Work>();
 }
 
-// The first decimal of a command number (G92.1 -> 1), or 0xFF with a finer fraction (G1.05).
+// x through a pointer the compiler cannot see through: its fields are then read and written with
+// a displacement from a pointer register (2 bytes an instruction), not at absolute addresses
+// (lds/sts, 4 bytes).
+template <typename T>
+T& opaque(T& x) {
+    T* p = &x;
+    asm("" : "+r"(p));
+    return *p;
+}
+
+// The first decimal of a command number (G92.1 -> 1) in the high nibble, as in Command::group,
+// or 0xFF with a finer fraction (G1.05).
 uint8_t tenths(const num::Decimal& d) {
     if (d.sub != 0 || (d.frac != 0 && (d.flags & num::Decimal::kInexact) != 0)) return 0xFF;
     uint8_t t = 0;
     for (uint16_t f = d.frac; f != 0; f = static_cast<uint16_t>(f - 100u)) {
         if (f < 100) return 0xFF;
-        ++t;
+        t = static_cast<uint8_t>(t + 0x10);
     }
     return t;
 }
@@ -253,7 +265,6 @@ uint8_t import_command(Block& b, uint8_t m, const num::Decimal& d) {
     if (d.negative() || d.ipart > 127) return kUnsupportedCommand;
     uint8_t key = static_cast<uint8_t>(d.ipart | m);
     uint8_t dec = tenths(d);
-    if (dec != 0xFF) dec = static_cast<uint8_t>(dec << 4); // as in Command::group
     const Command* c = nullptr;
     bool found = false;
     const Command* e = kCommands;
@@ -282,15 +293,17 @@ uint8_t import_command(Block& b, uint8_t m, const num::Decimal& d) {
     return kOk;
 }
 
-// Stage 2 for any other word, already read into its slot or into w.other.
+// Stage 2 for any other word, already read into its slot or into Work::other.
 uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
     WordMask wbit = bit(word);
     if (b.words & wbit) return kWordRepeated;
     if (d.negative() && (wbit & kNotNegative)) return kNegativeValue;
     b.words |= wbit;
     if (word == kWordS) {
-        b.s = d.ipart + (d.frac >= 500 ? 1u : 0u);
-    } else if (word >= kWordN && word <= kWordT) {
+        uint32_t v = d.ipart;
+        if (d.frac >= 500) ++v; // rounded half up
+        b.s = v;
+    } else if (word >= kWordN) { // N L T (the last words)
         // N 0..10000000 and L 0..254 (else checked in stage 3), T 0..255.
         uint32_t v;
         if (!num::to_uint(d, word == kWordN ? 10000000u : word == kWordL ? 254u : 255u, v)) {
@@ -308,17 +321,18 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
     return kOk;
 }
 
-// A length word in the units of the block, to um (or a feed to mm/min x1000).
-__attribute__((noinline)) bool length(const num::Decimal& d, int32_t& out) {
-    return num::length_to_milli(d, work().b.g[kGroupUnits] != 0, out);
+// The length word `word` of the block (its slot), in the units of the block, to um (or a feed to
+// mm/min x1000).
+__attribute__((noinline)) bool length(uint8_t word, int32_t& out) {
+    return num::length_to_milli(work().b.v[word].d, work().b.g[kGroupUnits] != 0, out);
 }
 
 // a + b, or a - b with `subtract`; an overflow sets Block::overflow (checked once per line:
 // error:33). Bit 31 of (a ^ r) & (b' ^ r) is the signed overflow of r = a + b'.
 __attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = false) {
     uint32_t ua = static_cast<uint32_t>(a), ub = static_cast<uint32_t>(b);
-    uint32_t r = subtract ? ua - ub : ua + ub;
-    if (subtract) ub = ~ub; // a - b overflows as a + ~b would (the sign of -b is ~b's)
+    if (subtract) ub = ~ub; // a - b = a + ~b + 1, and overflows as a + ~b would
+    uint32_t r = ua + ub + subtract;
     if (((ua ^ r) & (ub ^ r)) >> 31) work().b.overflow = 1;
     return static_cast<int32_t>(r);
 }
@@ -353,86 +367,69 @@ __attribute__((noinline)) void sub2(int32_t out[2], const int32_t p[2], const in
 
 // |p - q| for two points of the plane, um.
 __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
-    int32_t d[2];
+    uint32_t v[2];
+    int32_t* d = reinterpret_cast<int32_t*>(v);
     sub2(d, p, q);
-    uint32_t v[2] = {abs32(d[0]), abs32(d[1])};
+    for (uint8_t k = 0; k < 2; ++k) v[k] = abs32(d[k]);
     return sum_squares(v, 2).sqrt();
-}
-
-// How far (um, the larger of the two coordinates) the point p is from the point of the ellipse
-// of semi-axes `radii` centred on `centre` that has the same direction in the ellipse's own
-// scale (ellipse_direction): within a tick of it is on the ellipse. (A point so far out that the
-// difference wraps is refused by the range check anyway.)
-__attribute__((noinline)) uint32_t ellipse_gap_um(const int32_t p[2], const int32_t centre[2],
-                                                  const uint32_t radii[2]) {
-    int32_t xy[2], cs[2];
-    sub2(xy, p, centre);
-    ellipse_direction(xy[0], xy[1], radii, cs[0], cs[1]);
-    uint32_t gap = 0;
-    for (uint8_t k = 0; k < 2; ++k) {
-        uint32_t on = Num(radii[k]).mul(abs32(cs[k])).shift(-30).u32();
-        uint32_t d = static_cast<uint32_t>(xy[k]) - (cs[k] < 0 ? 0u - on : on);
-        d = abs32(static_cast<int32_t>(d));
-        if (d > gap) gap = d;
-    }
-    return gap;
 }
 
 // The step generator's fixed-point range (docs/curves.md): the ends, the control points or the
 // centre, and the semi-axes, within 2^22 steps; the length within 2^23 um (an arc's is at most
 // its larger semi-axis times its sweep; a Bezier's at most its control polygon's), and the
-// normal axis' travel too (an overflow of it flags the block). A function of its own, called by
-// execute() after check_curve() rather than under its frame: the deepest stack of a G-code line.
-__attribute__((noinline)) bool curve_in_range(const CurveParams& c) {
-    uint8_t ax[3];
-    plane_axes(c.plane, ax);
-    const int32_t dw_um = add(work().req.target_um[ax[2]], g_state.position[ax[2]], true);
-    Num reach{};                                                          // length bound, um
-    const int32_t* const pts[4] = {c.start_um, c.a_um, c.b_um, c.end_um}; // a G5's polygon
-    for (uint8_t i = 0; i < 4; ++i) {
-        for (uint8_t k = 0; k < 2; ++k) {
-            int32_t steps;
-            if (!num::mul_div_round(pts[i][k], g_settings.axis[ax[k]].steps_per_unit, 1000000u,
-                                    steps) ||
-                abs32(steps) > (1l << 22)) {
-                return false;
-            }
-        }
-        if (i != 0 && c.kind == kCurveBezier) {
-            int32_t d[2];
-            sub2(d, pts[i], pts[i - 1]);
-            reach.add(Num(abs32(d[0]))).add(Num(abs32(d[1])));
+// normal axis' travel too. An ellipse's ends must also be on it within the larger step + 2 um:
+// each coordinate that close to the ellipse's point that has the same direction in the
+// ellipse's own scale (ellipse_direction). (A function of its own, called by execute() after
+// check_curve(): a small stack frame, not on top of check_curve()'s.)
+__attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_t ax[3],
+                                              bool ellipse) {
+    static_assert(offsetof(CurveParams, end_um) == offsetof(CurveParams, start_um) + 8 &&
+                      offsetof(CurveParams, a_um) == offsetof(CurveParams, start_um) + 16 &&
+                      offsetof(CurveParams, b_um) == offsetof(CurveParams, start_um) + 24,
+                  "start, end, a, b: four points in a row");
+    const int32_t* const row = c.start_um; // (a pointer: indexing the array past 2 is undefined)
+    uint32_t spu_min = 0xFFFFFFFFu;
+    for (uint8_t i = 0; i < 8; ++i) {
+        int32_t steps;
+        uint32_t spu = g_settings.axis[ax[i & 1]].steps_per_unit;
+        if (spu < spu_min) spu_min = spu;
+        if (!num::mul_div_round(row[i], spu, 1000000u, steps) || abs32(steps) > (1l << 22)) {
+            return false;
         }
     }
-    if (c.kind == kCurveArc) {
+    // A circle's ends are checked in check_curve().
+    uint32_t gap_um = ellipse ? 1000000ul / spu_min + 2 : 0xFFFFFFFFu;
+    Num reach{}; // length bound, um
+    if (c.kind == kCurveBezier) {
+        // The control polygon start, a, b, end: points 0 2 3 1 of the row, 2 bits each.
+        for (uint8_t seq = 0x1E, prev = 0; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
+            uint8_t i = seq & 3;
+            int32_t d[2];
+            sub2(d, row + 2 * i, row + 2 * prev);
+            reach.add(Num(abs32(d[0]))).add(Num(abs32(d[1])));
+            prev = i;
+        }
+    } else {
         const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
         int32_t cs[4];
         for (uint8_t e = 0; e < 2; ++e) {
             int32_t p[2];
-            sub2(p, e ? c.end_um : c.start_um, c.a_um);
-            ellipse_direction(p[0], p[1], radii, cs[2 * e], cs[2 * e + 1]);
+            sub2(p, row + 2 * e, c.a_um);
+            int32_t* cse = &cs[2 * e];
+            ellipse_direction(p[0], p[1], radii, cse[0], cse[1]);
+            for (uint8_t k = 0; k < 2; ++k) {
+                uint32_t on = Num(abs32(cse[k]), -30).mul(radii[k]).u32(); // r |cs| (Q30)
+                uint32_t d = static_cast<uint32_t>(p[k]) - (cse[k] < 0 ? 0u - on : on);
+                if (abs32(static_cast<int32_t>(d)) > gap_um) return false;
+            }
         }
         int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], c.clockwise != 0, c.turns);
         // |sweep| < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r |sweep|.
         uint32_t q21 = static_cast<uint32_t>((sweep < 0 ? -sweep : sweep) >> 8);
-        reach.set(radii[0] > radii[1] ? radii[0] : radii[1]).mul(Num(q21, -21));
+        reach.set(q21, -21).mul(radii[0] > radii[1] ? radii[0] : radii[1]);
     }
-    reach.add(Num(abs32(dw_um)));
-    return reach.cmp(Num(1, 23)) < 0;
-}
-
-// An ellipse's ends on it: within one tick (the larger step of the plane's axes) + 0.002 mm. A
-// function of its own, called by execute() after check_curve() rather than under its frame, as
-// curve_in_range() (both reach ellipse_direction(): the deepest stack of a G-code line).
-__attribute__((noinline)) bool ellipse_ends_on(const CurveParams& c) {
-    uint8_t ax[3];
-    plane_axes(c.plane, ax);
-    const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
-    uint32_t spu = g_settings.axis[ax[0]].steps_per_unit;
-    uint32_t spv = g_settings.axis[ax[1]].steps_per_unit;
-    uint32_t tol = 1000000ul / (spu < spv ? spu : spv) + 2; // the larger step + 2 um
-    return ellipse_gap_um(c.start_um, c.a_um, radii) <= tol &&
-           ellipse_gap_um(c.end_um, c.a_um, radii) <= tol;
+    reach.add(Num(abs32(add(work().req.target_um[ax[2]], g_state.position[ax[2]], true))));
+    return reach.u32() < (1ul << 23); // (floor(x) < 2^23 exactly when x < 2^23)
 }
 
 // Stage 3 of a curve (docs/curves.md): the checks and errors of GRBL's arcs (26 32 33 34 35), our
@@ -440,12 +437,16 @@ __attribute__((noinline)) bool ellipse_ends_on(const CurveParams& c) {
 __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t axes,
                                               const State& st, CurveParams& c) {
     uint8_t ax[3];
-    c.plane = b.g[kGroupPlane];
-    plane_axes(c.plane, ax);
-    const uint8_t u = ax[0], v = ax[1];
-    const uint8_t in_plane = static_cast<uint8_t>((1u << u) | (1u << v));
+    const uint8_t plane = c.plane = b.g[kGroupPlane];
+    // plane_axes() as a rotation: (u, v, w) = axes (k - plane) mod 3.
+    for (uint8_t k = 0, a = static_cast<uint8_t>(plane ? 3 - plane : 0); k < 3; ++k) {
+        ax[k] = a;
+        a = a == 2 ? 0 : static_cast<uint8_t>(a + 1);
+    }
+    // The normal of plane p is axis 2 - p (plane_axes), so the plane's axes are X Y Z but it.
+    const uint8_t in_plane = static_cast<uint8_t>(7u ^ (4u >> plane));
     // A curve moves the plane's axes and, along a helix, the normal one: not the others.
-    if (axes & ~(in_plane | (1u << ax[2]))) return kAxisWordsExist;
+    if (axes & ~7u) return kAxisWordsExist;
     bool ellipse = motion == Motion::EllipseCw || motion == Motion::EllipseCcw;
     bool bezier = motion == Motion::Bezier;
     if (!ellipse && axes == 0) return kNoAxisWords;
@@ -453,15 +454,13 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     c.kind = bezier ? kCurveBezier : kCurveArc;
     c.clockwise = motion == Motion::ArcCw || motion == Motion::EllipseCw;
     c.turns = 0;
-    // o: the plane's offsets (I J, I K or J K), then P and Q, in um.
-    int32_t o[4];
-    const uint8_t words[4] = {static_cast<uint8_t>(kWordI + u), static_cast<uint8_t>(kWordI + v),
-                              kWordP, kWordQ};
+    // o: the plane's offsets (I J, I K or J K), then P and Q, in um; kept in c.a_um and c.b_um
+    // (a row of 4: checked in curve_in_range) until they become the points.
+    int32_t* const o = c.a_um;
     for (uint8_t k = 0; k < 4; ++k) {
+        uint8_t word = static_cast<uint8_t>(k < 2 ? kWordI + ax[k] : k == 2 ? kWordP : kWordQ);
         o[k] = 0;
-        if ((b.words & bit(words[k])) && !length(b.v[words[k]].d, o[k])) {
-            return kBadNumberFormat;
-        }
+        if ((b.words & bit(word)) && !length(word, o[k])) return kBadNumberFormat;
         if (k < 2) {
             c.start_um[k] = st.position[ax[k]];
             c.end_um[k] = work().req.target_um[ax[k]];
@@ -469,7 +468,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     }
     int32_t d[2]; // end - start
     sub2(d, c.end_um, c.start_um);
-    bool has_offsets = (b.words & (bit(words[0]) | bit(words[1]))) != 0;
+    bool has_offsets = ((b.words >> kWordI) & in_plane) != 0; // I J K are X Y Z's offsets
     bool has_pq = (b.words & bit(kWordP)) && (b.words & bit(kWordQ));
     const WordMask ijk = bit(kWordI) | bit(kWordJ) | bit(kWordK);
     WordMask used = static_cast<WordMask>(ijk | bit(kWordP) | bit(kWordQ)); // G2.1, G3.1, G5
@@ -480,42 +479,45 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         if (!has_pq) return kValueWordMissing;
         if (!has_offsets) {
             if (!st.g5_continues) return kValueWordMissing;
-            o[0] = st.g5_reflect[0];
-            o[1] = st.g5_reflect[1];
+            copy_words(o, st.g5_reflect, 2);
         }
     } else if (ellipse) {
         // G2.1 / G3.1: I J the centre from the start, P Q the semi-axes along the plane's
-        // axes; both ends on the ellipse within one tick + 0.002 mm (ellipse_ends_on()).
+        // axes; both ends on the ellipse within one tick + 0.002 mm (in curve_in_range()).
         if (!has_offsets) return kNoOffsetsInPlane;
         if (!has_pq) return kValueWordMissing;
-        if (o[2] <= 0 || o[3] <= 0) return kNegativeValue;
+        for (uint8_t k = 2; k < 4; ++k) {
+            if (o[k] <= 0) return kNegativeValue;
+        }
     } else {
         // G2 / G3, as GRBL: radius mode (R) or centre mode (the plane's offsets).
         used = bit(kWordP);
         if (b.words & bit(kWordR)) {
             used = static_cast<WordMask>(used | bit(kWordR)); // I J K stay unused (GRBL: 36)
             int32_t rw;
-            if (!length(b.v[kWordR].d, rw)) return kBadNumberFormat;
-            if (d[0] == 0 && d[1] == 0) return kInvalidTarget;
+            if (!length(kWordR, rw)) return kBadNumberFormat;
+            Num dn = dist_um(c.end_um, c.start_um); // |d|
+            if (dn.m == 0) return kInvalidTarget;   // start = end
             // Centre on the perpendicular bisector: h = -sqrt(4 r^2 - d^2) / d, negated for
             // G3 and for a negative R (the longer arc).
             r = abs32(rw);
-            const int32_t zero[2] = {0, 0};
-            Num dn = dist_um(d, zero);
             Num r2(r);
-            r2.mul(r2).mul(4u);
+            r2.mul(r2).shift(2); // 4 r^2
             Num d2 = dn;
             d2.mul(dn);
             if (r2.cmp(d2) < 0) return kArcRadiusError;
             uint32_t rr = r2.shift(-16).u32(), dd = d2.shift(-16).u32(); // both below 2^32
             Num h(rr - dd, 16);
-            h.sqrt().div(dn);                                     // |h|
-            bool neg = !((motion == Motion::ArcCcw) != (rw < 0)); // -sqrt(..), flipped
+            h.sqrt().div(dn); // |h|
+            // -sqrt(..), flipped for G3 and R < 0, and for u: x - y h = x + y (-h).
+            // (R's sign: rw != 0 here, else r2 < d2 above.)
+            bool neg = (motion == Motion::ArcCcw) != b.v[kWordR].d.negative();
             // o = (d - h (d1, -d0)) / 2: (x - y h) / 2, (y + x h) / 2.
             for (uint8_t k = 0; k < 2; ++k) {
                 int32_t t = static_cast<int32_t>(h.of(abs32(d[1 - k])));
                 if ((d[1 - k] < 0) != neg) t = -t;
-                o[k] = (k == 0 ? d[0] - t : d[1] + t) / 2;
+                o[k] = (d[k] + t) / 2;
+                neg = !neg;
             }
         } else if (!has_offsets) {
             return kNoOffsetsInPlane;
@@ -523,18 +525,21 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             used = static_cast<WordMask>(used | ijk);
         }
     }
-    for (uint8_t k = 0; k < 2; ++k) {
-        c.a_um[k] = add(c.start_um[k], o[k]);
-        c.b_um[k] = bezier ? add(c.end_um[k], o[k + 2]) : o[k + 2];
+    // a = start + the offsets; a G5's b = end + P Q (start, end: a row of 4 too).
+    const int32_t* const ends = c.start_um;
+    for (uint8_t k = 0; k < 4; ++k) {
+        if (k < 2 || bezier) o[k] = add(ends[k], o[k]);
     }
-    if (!ellipse && !bezier) { // (an ellipse's ends: ellipse_ends_on(), after this)
+    // (An ellipse's ends are checked in curve_in_range().)
+    if (!ellipse && !bezier) {
         if (!(b.words & bit(kWordR))) {
             // The end must be on the circle: within 0.005 mm, or else within 0.5 mm and 0.1 %.
             Num rn = dist_um(c.start_um, c.a_um);
             r = rn.u32();
             Num re = dist_um(c.end_um, c.a_um);
             uint32_t x = re.u32(), delta = x > r ? x - r : r - x;
-            if (delta > 5 && (delta > 500 || delta > r / 1000)) return kInvalidTarget;
+            // (delta > r / 1000 as delta * 1000 > r: the same for integers, delta <= 500.)
+            if (delta > 5 && (delta > 500 || delta * 1000u > r)) return kInvalidTarget;
         }
         if (r == 0) return kInvalidTarget;
         c.b_um[0] = static_cast<int32_t>(r);
@@ -560,8 +565,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     outcome.dwell_ms = 0;
 
     // ---- Stage 1: a block that starts from the current modes.
-    Work& w = work();
-    Block& b = w.b;
+    Block& b = opaque(work().b);
     static_assert(offsetof(State, tool) == sizeof(Modal) && sizeof(Modal) + 1 == 8,
                   "modal and tool are two words");
     b.g[kGroupNonModal] = kNoNonModal;
@@ -582,7 +586,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         char letter = *line++;
         if (letter < 'A' || letter > 'Z') return kExpectedCommandLetter;
         uint8_t word = flash_read_byte(&kLetterInfo[letter - 'A']);
-        num::Decimal& d = word < kDecimalSlots ? b.v[word].d : w.other;
+        num::Decimal& d = word < kDecimalSlots ? b.v[word].d : work().other;
         line = num::parse(line, d);
         if (line == nullptr) return kBadNumberFormat;
         uint8_t r = kUnsupportedCommand;
@@ -600,10 +604,10 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     uint8_t axes = static_cast<uint8_t>(b.words & kAxisWords);
     // [0] Axis words without a command that uses them: the current motion mode does; so do the
     // words of an ellipse without an end point (a full ellipse, docs/curves.md).
-    if (axes != 0 && b.axis_command == kAxisNone) b.axis_command = kAxisMotion;
     bool ellipse = motion == Motion::EllipseCw || motion == Motion::EllipseCcw;
-    if (ellipse && b.axis_command == kAxisNone &&
-        (b.words & (bit(kWordI) | bit(kWordJ) | bit(kWordK) | bit(kWordP) | bit(kWordQ)))) {
+    if (b.axis_command == kAxisNone &&
+        (axes != 0 || (ellipse && (b.words & (bit(kWordI) | bit(kWordJ) | bit(kWordK) |
+                                              bit(kWordP) | bit(kWordQ)))))) {
         b.axis_command = kAxisMotion;
     }
     // P: negative only as a G5 control point offset (GRBL refuses a negative P as error:4).
@@ -616,7 +620,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
     if (b.words & bit(kWordF)) {
         int32_t f;
-        if (!length(b.v[kWordF].d, f)) return kBadNumberFormat;
+        if (!length(kWordF, f)) return kBadNumberFormat;
         b.feed = static_cast<uint32_t>(f);
     }
 
@@ -635,7 +639,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
         if (!(m & 1)) continue;
         int32_t um;
-        if (!length(b.v[a].d, um)) return kBadNumberFormat;
+        if (!length(a, um)) return kBadNumberFormat;
         b.v[a].um = um;
     }
     // One pass over the axes computes either the new offsets (G10, G92) or the target of a
@@ -649,7 +653,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     };
     bool offsets = non_modal == kSetCoordData || non_modal == kSetOffset;
     const int32_t* keep = st.position;
-    const int32_t* other = st.g54;
+    uint8_t other = 2 * kAxes; // the other offset for kFromPosition: g54 (below), or g92
     uint8_t op = non_modal == kAbsoluteOverride ? kAsIs
                  : b.g[kGroupDistance]          ? kPlusPosition
                                                 : kPlusOffsets;
@@ -670,34 +674,42 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
             }
             b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
             keep = st.g54;
-            other = st.g92;
+            other = 3 * kAxes;
         }
     } else if (non_modal == kAbsoluteOverride && motion > Motion::Linear) {
         return kG53InvalidMotionMode;
     }
-    motion::LineRequest& req = w.req;
+    motion::LineRequest& req = work().req;
+    static_assert(offsetof(State, position_steps) == offsetof(State, position) + 4 * kAxes &&
+                      offsetof(State, g54) == offsetof(State, position) + 8 * kAxes &&
+                      offsetof(State, g92) == offsetof(State, position) + 12 * kAxes &&
+                      offsetof(motion::LineRequest, target_um) ==
+                          offsetof(motion::LineRequest, target_steps) + 4 * kAxes,
+                  "the arrays of axes in a row");
     if (offsets || b.axis_command == kAxisMotion) {
         copy_words(req.target_um, keep, kAxes); // for G10 / G92: the new offsets
         copy_words(req.target_steps, st.position_steps, kAxes);
         for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
             if (!(m & 1)) continue;
+            // Axis a of the arrays in a row: st's position (+ kAxes: position_steps, + 2 kAxes:
+            // g54, + 3 kAxes: g92) and req's target_steps (+ kAxes: target_um).
+            const int32_t* const sa = st.position + a;
+            int32_t* const ra = req.target_steps + a;
             int32_t t = b.v[a].um;
             if (op == kPlusPosition) {
-                t = add(t, st.position[a]);
+                t = add(t, sa[0]);
             } else if (op == kPlusOffsets) {
-                t = add(add(t, st.g54[a]), st.g92[a]);
+                t = add(add(t, sa[2 * kAxes]), sa[3 * kAxes]);
             } else if (op == kFromPosition) {
-                t = add(add(st.position[a], other[a], true), t, true);
+                t = add(add(sa[0], sa[other], true), t, true);
             }
-            req.target_um[a] = t;
+            ra[kAxes] = t;
             // Always from the absolute target: no rounding error accumulates. One move travels
             // at most kMaxLineTicks steps per axis (line.h).
-            int32_t& steps = req.target_steps[a];
             if (!offsets &&
-                (!num::mul_div_round(t, g_settings.axis[a].steps_per_unit, 1000000u, steps) ||
-                 abs32(static_cast<int32_t>(static_cast<uint32_t>(steps) -
-                                            static_cast<uint32_t>(st.position_steps[a]))) >
-                     kMaxLineTicks)) {
+                (!num::mul_div_round(t, g_settings.axis[a].steps_per_unit, 1000000u, ra[0]) ||
+                 abs32(static_cast<int32_t>(static_cast<uint32_t>(ra[0]) -
+                                            static_cast<uint32_t>(sa[kAxes]))) > kMaxLineTicks)) {
                 b.overflow = 1;
             }
         }
@@ -711,12 +723,14 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     } else if (b.axis_command == kAxisMotion) {
         if (motion != Motion::Seek && b.feed == 0) return kUndefinedFeedRate;
         if (motion >= Motion::ArcCw && motion <= Motion::Bezier) {
-            uint8_t r = check_curve(b, motion, axes, st, b.curve);
+            uint8_t r =
+                check_curve(work().b, motion, axes, st, work().b.curve); // (at fixed addresses)
             if (r != kOk) return r;
-            // (In check_curve()'s order: the ends of an ellipse, the range, the overflows.)
-            if ((ellipse && !ellipse_ends_on(b.curve)) || !curve_in_range(b.curve) || b.overflow) {
-                return kInvalidTarget;
-            }
+            // Called here rather than under check_curve()'s frame: it reaches
+            // ellipse_direction(), the deepest stack of a G-code line.
+            uint8_t ax[3];
+            plane_axes(b.curve.plane, ax);
+            if (!curve_in_range(b.curve, ax, ellipse)) return kInvalidTarget;
             curve = true;
         } else if (axes == 0) {
             b.axis_command = kAxisNone; // G0/G1 alone: a mode change only
@@ -791,8 +805,9 @@ bool reset() {
 }
 
 void steps_to_um(const int32_t* steps, int32_t* um) {
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        num::mul_div_round(steps[a], 1000000u, g_settings.axis[a].steps_per_unit, um[a]);
+    const AxisSettings* s = g_settings.axis;
+    for (uint8_t a = kAxes; a != 0; --a) {
+        num::mul_div_round(*steps++, 1000000u, (s++)->steps_per_unit, *um++);
     }
 }
 

@@ -127,6 +127,10 @@ TEST_F(Curves, BadArcsGetGrblsErrorCodes) {
     EXPECT_EQ(run("G2.1 X10 I5 J0 P4 Q3 F600"), "error:33\r\n");
     EXPECT_EQ(run("G2.1 X10 I5 J0 F600"), "error:28\r\n");
     EXPECT_EQ(run("G2.1 X10 P5 Q3 F600"), "error:35\r\n");
+    // Values that round to zero: an R0 (too short, whatever its sign), a semi-axis 0.
+    EXPECT_EQ(run("G2 X10 R-0.0001 F600"), "error:34\r\n");
+    EXPECT_EQ(run("G2.1 X10 I5 J0 P-5 Q3 F600"), "error:4\r\n");
+    EXPECT_EQ(run("G2.1 X10 I5 J0 P5 Q0.0001 F600"), "error:4\r\n");
     // G5: P Q required; I J required unless it continues a G5.
     EXPECT_EQ(run("G5 X10 I1 J1 F600"), "error:28\r\n");
     EXPECT_EQ(run("G5 X10 P-1 Q1 F600"), "error:28\r\n");
@@ -151,6 +155,21 @@ TEST_F(Curves, EllipseEndsMustLieOnTheEllipseWithinAStep) {
     EXPECT_EQ(run("G0 X0 Y0"), "ok\r\n");
     EXPECT_EQ(run("G2.1 X5 Y2.985 I5 J0 P5 Q3 F600"), "error:33\r\n");
     EXPECT_EQ(run("G2.1 X10 I5.015 J0 P5 Q3 F600"), "error:33\r\n"); // the start is off
+}
+
+// GRBL's tolerance for an arc's end: within 0.005 mm of the circle, or else within 0.5 mm and
+// 0.1 % of the radius (here 20 mm: 0.020 mm). Checked in check mode ($C): nothing moves.
+TEST_F(Curves, ArcEndsMustLieOnTheCircleWithinGrblsTolerance) {
+    ASSERT_EQ(run("$C"), "[MSG:Enabled]\r\nok\r\n");
+    EXPECT_EQ(run("G2 X40.020 I20 J0 F600"), "ok\r\n");
+    EXPECT_EQ(run("G0 X0 Y0"), "ok\r\n");
+    EXPECT_EQ(run("G2 X40.021 I20 J0 F600"), "error:33\r\n");
+    EXPECT_EQ(run("G2 X39.980 I20 J0 F600"), "ok\r\n");
+    EXPECT_EQ(run("G0 X0 Y0"), "ok\r\n");
+    EXPECT_EQ(run("G2 X39.979 I20 J0 F600"), "error:33\r\n");
+    EXPECT_EQ(run("G2 X4.005 I2 J0 F600"), "ok\r\n"); // r 2 mm: 0.005 mm
+    EXPECT_EQ(run("G0 X0 Y0"), "ok\r\n");
+    EXPECT_EQ(run("G2 X4.006 I2 J0 F600"), "error:33\r\n");
 }
 
 // Radius mode: the centre is on the chord's bisector, on the right of the way for G2 with R > 0,

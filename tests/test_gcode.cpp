@@ -240,6 +240,10 @@ TEST_F(GCode, TrackedWordsAppearInTheParserState) {
     EXPECT_EQ(ll::host::take_output(), "[GC:G80 G54 G17 G21 G90 G94 M4 M8 T3 F0 S1200]\r\n");
     ok("G19");
     EXPECT_EQ(gcode::g_state.modal.plane, 2);
+    ok("S1199.5"); // S rounded half up to whole rpm
+    EXPECT_EQ(gcode::g_state.spindle_speed, 1200u);
+    ok("S1199.499");
+    EXPECT_EQ(gcode::g_state.spindle_speed, 1199u);
 }
 
 TEST_F(GCode, CheckModeUpdatesTheParserButMovesNothing) {
