@@ -464,6 +464,17 @@ bool Sim::has_symbol(const std::string& name) const {
     return false;
 }
 
+std::string Sim::symbol_with_prefix(const std::string& prefix) const {
+#if ELF_SYMBOLS
+    for (uint32_t i = 0; i < fw_.symbolcount; ++i) {
+        if (fw_.symbol[i] && strncmp(fw_.symbol[i]->symbol, prefix.c_str(), prefix.size()) == 0)
+            return fw_.symbol[i]->symbol;
+    }
+#endif
+    (void)prefix;
+    return "";
+}
+
 uint32_t Sim::symbol(const std::string& name) const {
 #if ELF_SYMBOLS
     constexpr uint32_t kDataSpace = 0x800000; // avr-gcc's offset of SRAM addresses in the ELF

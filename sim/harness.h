@@ -167,6 +167,8 @@ class Sim {
     /// Throws SimError when missing.
     uint32_t symbol(const std::string& name) const;
     bool has_symbol(const std::string& name) const;
+    /// The first symbol whose name starts with `prefix` ("" when none).
+    std::string symbol_with_prefix(const std::string& prefix) const;
 
     /// Records every CPU write to `data_addr` (e.g. GPIOR0 0x3E used as a code-region marker).
     void watch_register(uint16_t data_addr);

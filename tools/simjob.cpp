@@ -1,5 +1,7 @@
 #include "simjob.h"
 
+#include <ctype.h>
+
 #include <fcntl.h>
 #include <gelf.h>
 #include <libelf.h>
@@ -185,11 +187,28 @@ constexpr uint16_t kSph = 0x5E;
 constexpr uint8_t kVectors = 26;
 } // namespace
 
+// A function's symbol, or when its signature changed since the name was written, the one with
+// the same nested name (_ZN2ll7StepGen4fillE...: the part up to the E closing the name).
+std::string resolve(const Sim& sim, const std::string& name) {
+    if (sim.has_symbol(name)) return name;
+    size_t i = name.compare(0, 4, "_ZNK") == 0 ? 4 : name.compare(0, 3, "_ZN") == 0 ? 3 : 0;
+    if (i == 0) return "";
+    while (i < name.size() && isdigit(static_cast<unsigned char>(name[i]))) {
+        size_t len = 0;
+        while (i < name.size() && isdigit(static_cast<unsigned char>(name[i])))
+            len = len * 10 + static_cast<size_t>(name[i++] - '0');
+        i += len;
+    }
+    if (i >= name.size() || name[i] != 'E') return "";
+    return sim.symbol_with_prefix(name.substr(0, i + 1));
+}
+
 Profiler::Profiler(Sim& sim, const std::vector<std::string>& symbols)
-    : sim_(sim), names_(symbols), fn_at_(32768 / 2, -1) {
+    : sim_(sim), names_(symbols), fn_at_((sim.avr()->flashend + 1u) / 2, -1) {
     for (size_t i = 0; i < symbols.size(); ++i) {
-        if (!sim.has_symbol(symbols[i])) continue;
-        const uint32_t addr = sim.symbol(symbols[i]);
+        const std::string name = resolve(sim, symbols[i]);
+        if (name.empty()) continue;
+        const uint32_t addr = sim.symbol(name);
         if (addr / 2 < fn_at_.size()) fn_at_[addr / 2] = static_cast<int16_t>(i);
     }
     for (uint8_t v = 1; v < kVectors; ++v) sim.record_isr(v);
@@ -246,7 +265,6 @@ uint64_t Profiler::isr_cycles_in(uint64_t from, uint64_t to) const {
 
 namespace {
 constexpr uint8_t kPaint = 0xA5;
-constexpr unsigned kRamEnd = 0x8FF; // ATmega328P
 } // namespace
 
 StackProbe::StackProbe(Sim& sim) : sim_(sim), bss_end_(sim.symbol("__bss_end")) {
@@ -264,7 +282,7 @@ unsigned StackProbe::peak() const {
             break;
         }
     }
-    return kRamEnd + 1 - lowest;
+    return sim_.avr()->ramend + 1u - lowest; // 0x8FF on the 328P (LLSIM_BIG_RAM: 0xFFF)
 }
 
 bool StackProbe::overflowed() const {
