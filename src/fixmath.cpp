@@ -763,6 +763,13 @@ Num num64(uint32_t hi, uint32_t lo, int8_t exp) {
 #endif
 
 #if !defined(__AVR__) // AVR: fixmath_avr.cpp
+Num& Num::shift(int8_t k) {
+    if (m) e = static_cast<int8_t>(e + k);
+    return *this;
+}
+#endif
+
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 uint32_t Num::u32() const {
     if (m == 0 || e <= -32) return 0;
     if (e > 0) return 0xFFFFFFFFul;

@@ -43,12 +43,18 @@ asm(".section .text.__ll_norm,\"ax\",@progbits\n"
     ".size __ll_norm, .-__ll_norm\n"
     ".text\n");
 
-// Num& Num::set(uint32_t v, int8_t exp): v in r20..r23, exp in r18. Normalised by __ll_norm;
-// an exponent below -128 gives zero (above 127 is impossible: it only decreases).
-asm(".section .text._ZN2ll3Num3setEma,\"ax\",@progbits\n"
-    ".global _ZN2ll3Num3setEma\n"
-    ".type _ZN2ll3Num3setEma, @function\n"
-    "_ZN2ll3Num3setEma:\n"
+// Num& Num::set(uint32_t v, int8_t exp) (fixmath.h's inline set calls these): v in r20..r23,
+// exp in r18; __ll_set0 for a constant exp = 0 (most calls: the caller saves loading it).
+// Normalised by __ll_norm; an exponent below -128 gives zero (above 127 is impossible: the
+// shift only decreases it, by 0..31, so the 8-bit sum overflows exactly then).
+asm(".section .text.__ll_set,\"ax\",@progbits\n"
+    ".global __ll_set0\n"
+    ".type __ll_set0, @function\n"
+    "__ll_set0:\n"
+    "clr  r18\n"
+    ".global __ll_set\n"
+    ".type __ll_set, @function\n"
+    "__ll_set:\n"
     "movw r30, r24\n"
     "mov  r27, r18\n" // exp
     "movw r18, r20\n"
@@ -56,18 +62,8 @@ asm(".section .text._ZN2ll3Num3setEma,\"ax\",@progbits\n"
     "call __ll_norm\n"
     "tst  r21\n"
     "breq .Lset_zero\n"
-    "clr  r23\n" // r23:r27 = exp
-    "sbrc r27, 7\n"
-    "com  r23\n"
-    "clr  r22\n" // r22:r26 = minus the shift
-    "sbrc r26, 7\n"
-    "com  r22\n"
     "add  r27, r26\n"
-    "adc  r23, r22\n"
-    "cpi  r27, 0x80\n"
-    "ldi  r22, 0xFF\n"
-    "cpc  r23, r22\n"
-    "brlt .Lset_zero\n"
+    "brvs .Lset_zero\n"
     "st   Z, r18\n"
     "std  Z+1, r19\n"
     "std  Z+2, r20\n"
@@ -81,7 +77,7 @@ asm(".section .text._ZN2ll3Num3setEma,\"ax\",@progbits\n"
     "std  Z+3, r1\n"
     "std  Z+4, r1\n"
     "ret\n"
-    ".size _ZN2ll3Num3setEma, .-_ZN2ll3Num3setEma\n");
+    ".size __ll_set, .-__ll_set\n");
 
 // Num& Num::mul(const Num& o): &o in r22:r23. The 64-bit product of the mantissas by
 // __ll_mul32 (fixmath.cpp), its top 33 bits normalised; truncated.
@@ -95,9 +91,18 @@ asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n"
     "clt\n"
     "rjmp 1f\n"
     ".size _ZN2ll3Num4mulcEma, .-_ZN2ll3Num4mulcEma\n"
-    ".global _ZN2ll3Num3mulEm\n" // Num& Num::mul(uint32_t v): v in r20..r23, normalised here
-    ".type _ZN2ll3Num3mulEm, @function\n"
-    "_ZN2ll3Num3mulEm:\n"
+    // Num& Num::mul(uint32_t v): v in r20..r23, normalised here; __ll_mul8 for a constant
+    // below 256, in r22 (the caller saves three loads).
+    ".global __ll_mul8\n"
+    ".type __ll_mul8, @function\n"
+    "__ll_mul8:\n"
+    "mov  r20, r22\n"
+    "clr  r21\n"
+    "clr  r22\n"
+    "clr  r23\n"
+    ".global __ll_mul\n"
+    ".type __ll_mul, @function\n"
+    "__ll_mul:\n"
     "set\n"
     "1:\n"
     "push r12\n"
@@ -122,7 +127,7 @@ asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n"
     "ldd  r25, Y+3\n"
     "ldd  r26, Y+4\n"
     "rjmp .Lmul_loaded\n"
-    ".size _ZN2ll3Num3mulEm, .-_ZN2ll3Num3mulEm\n"
+    ".size __ll_mul, .-__ll_mul\n"
     ".global _ZN2ll3Num3mulERKS0_\n"
     ".type _ZN2ll3Num3mulERKS0_, @function\n"
     "_ZN2ll3Num3mulERKS0_:\n"
@@ -220,9 +225,19 @@ asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n"
     ".size _ZN2ll3Num3mulERKS0_, .-_ZN2ll3Num3mulERKS0_\n");
 
 asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n" // with mul: one shared tail
-    ".global _ZN2ll3Num3divEm\n" // Num& Num::div(uint32_t v): v in r20..r23, normalised here
-    ".type _ZN2ll3Num3divEm, @function\n"
-    "_ZN2ll3Num3divEm:\n"
+                                                             // Num& Num::div(uint32_t v): v in
+                                                             // r20..r23, normalised here; __ll_div8
+                                                             // as __ll_mul8.
+    ".global __ll_div8\n"
+    ".type __ll_div8, @function\n"
+    "__ll_div8:\n"
+    "mov  r20, r22\n"
+    "clr  r21\n"
+    "clr  r22\n"
+    "clr  r23\n"
+    ".global __ll_div\n"
+    ".type __ll_div, @function\n"
+    "__ll_div:\n"
     "push r12\n"
     "push r13\n"
     "push r14\n"
@@ -240,7 +255,7 @@ asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n" // with mul: one sh
     "ldd  r25, Y+3\n"
     "ldd  r26, Y+4\n"
     "rjmp .Ldiv_loaded\n"
-    ".size _ZN2ll3Num3divEm, .-_ZN2ll3Num3divEm\n"
+    ".size __ll_div, .-__ll_div\n"
     ".global _ZN2ll3Num3divERKS0_\n"
     ".type _ZN2ll3Num3divERKS0_, @function\n"
     "_ZN2ll3Num3divERKS0_:\n"
@@ -754,6 +769,28 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "pop  r13\n"
     "ret\n"
     ".size _ZN2ll7mul_shrEmmh, .-_ZN2ll7mul_shrEmmh\n"
+    ".text\n");
+
+// Num& Num::shift(int8_t k): k in r22; e += k unless the value is zero.
+asm(".section .text._ZN2ll3Num5shiftEa,\"ax\",@progbits\n"
+    ".global _ZN2ll3Num5shiftEa\n"
+    ".type _ZN2ll3Num5shiftEa, @function\n"
+    "_ZN2ll3Num5shiftEa:\n"
+    "movw r30, r24\n"
+    "ld   r18, Z\n"
+    "ldd  r19, Z+1\n"
+    "or   r18, r19\n"
+    "ldd  r19, Z+2\n"
+    "or   r18, r19\n"
+    "ldd  r19, Z+3\n"
+    "or   r18, r19\n"
+    "breq 1f\n"
+    "ldd  r18, Z+4\n"
+    "add  r18, r22\n"
+    "std  Z+4, r18\n"
+    "1:\n"
+    "ret\n"
+    ".size _ZN2ll3Num5shiftEa, .-_ZN2ll3Num5shiftEa\n"
     ".text\n");
 
 #endif // __AVR__
