@@ -228,56 +228,13 @@ uint16_t isqrt32(uint32_t v) {
 #endif
 }
 
+#if !defined(__AVR__) // AVR: Num::sqrt in fixmath_avr.cpp
 namespace {
 
 // floor(rem * 2^15 / s) for 2^15 <= s < 2^16 and rem <= 2 s: the Newton correction of a
 // square root (a quotient below 2^17).
 uint32_t sqrt_step(uint32_t rem, uint16_t s) {
     // rem = q0 s + r with q0 <= 2, then 15 quotient bits of r * 2^15 / s.
-#if defined(__AVR__)
-    // One block: q0 counted into the quotient's low byte, which the 15 turns then shift up to
-    // bits 15..16 (a 3-byte quotient; its top byte stays zero).
-    uint32_t q;
-    uint8_t n;
-    asm("clr  %A[q]\n\t"
-        "clr  %B[q]\n\t"
-        "clr  %C[q]\n\t"
-        "clr  %D[q]\n"
-        "0:\n\t"
-        "cp   %A[r], %A[s]\n\t"
-        "cpc  %B[r], %B[s]\n\t"
-        "cpc  %C[r], __zero_reg__\n\t"
-        "cpc  %D[r], __zero_reg__\n\t"
-        "brcs 4f\n\t"
-        "sub  %A[r], %A[s]\n\t"
-        "sbc  %B[r], %B[s]\n\t"
-        "sbc  %C[r], __zero_reg__\n\t"
-        "sbc  %D[r], __zero_reg__\n\t"
-        "inc  %A[q]\n\t"
-        "rjmp 0b\n"
-        "4:\n\t"
-        "ldi  %[n], 15\n"
-        "1:\n\t"
-        "lsl  %A[q]\n\t"
-        "rol  %B[q]\n\t"
-        "rol  %C[q]\n\t"
-        "lsl  %A[r]\n\t"
-        "rol  %B[r]\n\t"
-        "brcs 2f\n\t"
-        "cp   %A[r], %A[s]\n\t"
-        "cpc  %B[r], %B[s]\n\t"
-        "brcs 3f\n"
-        "2:\n\t"
-        "sub  %A[r], %A[s]\n\t"
-        "sbc  %B[r], %B[s]\n\t"
-        "inc  %A[q]\n"
-        "3:\n\t"
-        "dec  %[n]\n\t"
-        "brne 1b"
-        : [q] "=&r"(q), [r] "+r"(rem), [n] "=&d"(n)
-        : [s] "r"(s));
-    return q;
-#else
     uint8_t q0 = 0;
     while (rem >= s) {
         rem -= s;
@@ -295,10 +252,10 @@ uint32_t sqrt_step(uint32_t rem, uint16_t s) {
         }
     }
     return static_cast<uint32_t>(q0) << 15 | q;
-#endif
 }
 
 } // namespace
+#endif
 
 uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits) {
     uint32_t q = 0, rem = num;
@@ -701,6 +658,7 @@ Num& Num::add(const Num& o) {
 }
 #endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::sqrt() {
     if (m == 0) return *this;
     // Make the exponent even: value = m' * 2^e' with m' in [2^30, 2^32).
@@ -729,6 +687,8 @@ Num& Num::sqrt() {
     e = ex;
     return *this;
 }
+
+#endif
 
 Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask) {
     // Exact 64-bit sums while every value is below 2^30 (6 squares below 2^63); larger values
