@@ -336,11 +336,13 @@ uint32_t shl_sat(uint32_t x, uint8_t k) {
 
 namespace {
 
+#if !defined(__AVR__) // AVR: atan2_q29 in fixmath_avr.cpp, with its copy
 // atan(2^-i) in radians x 2^29 for i <= 10; beyond, atan(2^-i) = 2^-i to the last bit (and
 // 2^-10 already is: the last entry is 2^19, halved from there on).
 const uint32_t kAtanQ29[11] LL_PROGMEM = {421657428, 248918915, 131521918, 66762579,
                                           33510843,  16771758,  8387925,   4194219,
                                           2097141,   1048575,   524288};
+#endif
 
 // (a * b) >> 30 for Q30 operands (the arithmetic shift of the exact 64-bit product). From the
 // unsigned product: a negative operand subtracts the other one times 2^32.
@@ -360,6 +362,7 @@ int32_t horner(int32_t x, int32_t r, int32_t t) {
 
 } // namespace
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 int32_t atan2_q29(int32_t y, int32_t x) {
     if (x == 0 && y == 0) return 0;
     // Bring the vector into the right half plane with a quarter turn, then normalise it to
@@ -389,101 +392,6 @@ int32_t atan2_q29(int32_t y, int32_t x) {
         y *= 2;
         big <<= 1;
     }
-#if defined(__AVR__)
-    // The same 30 turns with one 4-byte temporary: x >> i (or y >> i) is applied first, and
-    // the other operand's old value is then recovered from the new one (t + y' = y, t + x' = x)
-    // before its own shift. One shift loop, called twice per turn.
-    uint32_t a, t;
-    uint8_t i, n;
-    const uint32_t* tab = kAtanQ29;
-    asm("clr  %[i]\n"
-        "0:\n\t"
-        "cpi  %[i], 11\n\t"
-        "brsh 1f\n\t"
-        "lpm  %A[a], Z+\n\t"
-        "lpm  %B[a], Z+\n\t"
-        "lpm  %C[a], Z+\n\t"
-        "lpm  %D[a], Z+\n\t"
-        "rjmp 2f\n"
-        "1:\n\t"
-        "lsr  %D[a]\n\t"
-        "ror  %C[a]\n\t"
-        "ror  %B[a]\n\t"
-        "ror  %A[a]\n"
-        "2:\n\t"
-        "sbrc %D[y], 7\n\t"
-        "rjmp 3f\n\t"
-        "cp   %A[y], __zero_reg__\n\t"
-        "cpc  %B[y], __zero_reg__\n\t"
-        "cpc  %C[y], __zero_reg__\n\t"
-        "cpc  %D[y], __zero_reg__\n\t"
-        "breq 3f\n\t"
-        // y > 0: y -= x >> i, x += y >> i (old y), z += a
-        "movw %A[t], %A[x]\n\t"
-        "movw %C[t], %C[x]\n\t"
-        "rcall 5f\n\t"
-        "sub  %A[y], %A[t]\n\t"
-        "sbc  %B[y], %B[t]\n\t"
-        "sbc  %C[y], %C[t]\n\t"
-        "sbc  %D[y], %D[t]\n\t"
-        "add  %A[t], %A[y]\n\t"
-        "adc  %B[t], %B[y]\n\t"
-        "adc  %C[t], %C[y]\n\t"
-        "adc  %D[t], %D[y]\n\t"
-        "rcall 5f\n\t"
-        "add  %A[x], %A[t]\n\t"
-        "adc  %B[x], %B[t]\n\t"
-        "adc  %C[x], %C[t]\n\t"
-        "adc  %D[x], %D[t]\n\t"
-        "add  %A[z], %A[a]\n\t"
-        "adc  %B[z], %B[a]\n\t"
-        "adc  %C[z], %C[a]\n\t"
-        "adc  %D[z], %D[a]\n\t"
-        "rjmp 4f\n"
-        // y <= 0: x -= y >> i, y += x >> i (old x), z -= a
-        "3:\n\t"
-        "movw %A[t], %A[y]\n\t"
-        "movw %C[t], %C[y]\n\t"
-        "rcall 5f\n\t"
-        "sub  %A[x], %A[t]\n\t"
-        "sbc  %B[x], %B[t]\n\t"
-        "sbc  %C[x], %C[t]\n\t"
-        "sbc  %D[x], %D[t]\n\t"
-        "add  %A[t], %A[x]\n\t"
-        "adc  %B[t], %B[x]\n\t"
-        "adc  %C[t], %C[x]\n\t"
-        "adc  %D[t], %D[x]\n\t"
-        "rcall 5f\n\t"
-        "add  %A[y], %A[t]\n\t"
-        "adc  %B[y], %B[t]\n\t"
-        "adc  %C[y], %C[t]\n\t"
-        "adc  %D[y], %D[t]\n\t"
-        "sub  %A[z], %A[a]\n\t"
-        "sbc  %B[z], %B[a]\n\t"
-        "sbc  %C[z], %C[a]\n\t"
-        "sbc  %D[z], %D[a]\n"
-        "4:\n\t"
-        "inc  %[i]\n\t"
-        "cpi  %[i], 30\n\t"
-        "brlo 0b\n\t"
-        "rjmp 7f\n"
-        // t >>= i, arithmetic
-        "5:\n\t"
-        "mov  %[n], %[i]\n\t"
-        "rjmp 6f\n"
-        "8:\n\t"
-        "asr  %D[t]\n\t"
-        "ror  %C[t]\n\t"
-        "ror  %B[t]\n\t"
-        "ror  %A[t]\n"
-        "6:\n\t"
-        "dec  %[n]\n\t"
-        "brpl 8b\n\t"
-        "ret\n"
-        "7:"
-        : [x] "+r"(x), [y] "+r"(y), [z] "+r"(z), [a] "=&r"(a), [t] "=&r"(t), [i] "=&d"(i),
-          [n] "=&r"(n), "+z"(tab));
-#else
     uint32_t a = 0;
     for (uint8_t i = 0; i < 30; ++i) {
         a = i <= 10 ? flash_read_u32(&kAtanQ29[i]) : a >> 1;
@@ -498,9 +406,9 @@ int32_t atan2_q29(int32_t y, int32_t x) {
             z -= static_cast<int32_t>(a);
         }
     }
-#endif
     return z;
 }
+#endif
 
 void small_angle_q30(int32_t h, int32_t& c, int32_t& s, int32_t& k) {
     // Reciprocals 1/n in Q30 for the series' coefficient ratios.
