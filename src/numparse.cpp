@@ -43,12 +43,13 @@ const char* parse(const char* p, Decimal& out) {
         }
         // Decimals 1-3 make `frac` (0..999), 4-5 `sub` (0..99), each weighted by its place.
         static const uint8_t kWeight[5] LL_PROGMEM = {100, 10, 1, 10, 1};
-        if (place < 3) {
-            frac = static_cast<uint16_t>(
-                frac + static_cast<uint16_t>(d * flash_read_byte(&kWeight[place])));
-        } else if (place < 5) {
-            sub = static_cast<uint8_t>(sub +
-                                       static_cast<uint8_t>(d * flash_read_byte(&kWeight[place])));
+        if (place < 5) {
+            uint16_t dw = static_cast<uint16_t>(d * flash_read_byte(&kWeight[place]));
+            if (place < 3) {
+                frac = static_cast<uint16_t>(frac + dw);
+            } else {
+                sub = static_cast<uint8_t>(sub + dw);
+            }
         } else {
             if (place == 5 && d >= 5) flags |= Decimal::kRound6;
             if (d != 0) flags |= Decimal::kInexact;
