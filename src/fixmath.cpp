@@ -13,7 +13,21 @@ namespace {
 // r27, r30, r31 and r0 (r1 back to zero). Column k of the byte products (i + j = k) is summed
 // into a 3-byte window (a column's sum plus the carry from below stays under 2^24), whose low
 // byte is then final: result byte k.
+// __ll_mul32s: the same keeping r14..r17, for the assembly routines whose own operands are there
+// or that would otherwise save them (4 pushes here instead of in each caller).
 asm(".section .text.__ll_mul32,\"ax\",@progbits\n"
+    ".global __ll_mul32s\n"
+    "__ll_mul32s:\n"
+    "push r14\n"
+    "push r15\n"
+    "push r16\n"
+    "push r17\n"
+    "rcall __ll_mul32\n"
+    "pop  r17\n"
+    "pop  r16\n"
+    "pop  r15\n"
+    "pop  r14\n"
+    "ret\n"
     ".global __ll_mul32\n"
     "__ll_mul32:\n"
     "movw r26, r18\n"

@@ -97,16 +97,12 @@ bool to_uint(const Decimal& d, uint32_t max, uint32_t& out) {
 #if defined(__AVR__)
 // mul_div_round on the chip, as one routine (the portable C below is the reference: the host
 // tests check it, and tools/fixmath_check.h compares both): a in r22..r25, b in r18..r21, c in
-// r14..r17 (saved around __ll_mul32, which uses them), &out in r12:r13; true/false in r24. The
-// sign in T, the magnitude's product by __ll_mul32 (fixmath.cpp), + c/2, then divide().
+// r14..r17 (kept by __ll_mul32s), &out in r12:r13; true/false in r24. The sign in T, the
+// magnitude's product by __ll_mul32s (fixmath.cpp), + c/2, then divide().
 asm(".section .text._ZN2ll3num13mul_div_roundElmmRl,\"ax\",@progbits\n"
     ".global _ZN2ll3num13mul_div_roundElmmRl\n"
     ".type _ZN2ll3num13mul_div_roundElmmRl, @function\n"
     "_ZN2ll3num13mul_div_roundElmmRl:\n"
-    "push r14\n"
-    "push r15\n"
-    "push r16\n"
-    "push r17\n"
     "bst  r25, 7\n" // T: a < 0
     "brtc 1f\n"
     "com  r25\n"
@@ -117,12 +113,8 @@ asm(".section .text._ZN2ll3num13mul_div_roundElmmRl,\"ax\",@progbits\n"
     "sbci r24, 0xFF\n"
     "sbci r25, 0xFF\n"
     "1:\n"
-    "call __ll_mul32\n" // q (low word) in r18..r21, r (high word) in r22..r25
-    "pop  r17\n"
-    "pop  r16\n"
-    "pop  r15\n"
-    "pop  r14\n"
-    "movw r26, r14\n" // + c/2, half away from zero on the magnitude
+    "call __ll_mul32s\n" // q (low word) in r18..r21, r (high word) in r22..r25
+    "movw r26, r14\n"    // + c/2, half away from zero on the magnitude
     "movw r30, r16\n"
     "lsr  r31\n"
     "ror  r30\n"
