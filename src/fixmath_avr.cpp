@@ -214,10 +214,9 @@ asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n"
     "ret\n"
     ".size _ZN2ll3Num3mulERKS0_, .-_ZN2ll3Num3mulERKS0_\n");
 
-asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n" // with mul: one shared tail
-                                                             // Num& Num::div(uint32_t v): v in
-                                                             // r20..r23, normalised here; __ll_div8
-                                                             // as __ll_mul8.
+// Num& Num::div(uint32_t v): v in r20..r23, normalised here; __ll_div8 as __ll_mul8. In mul's
+// section: one shared tail.
+asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n"
     ".global __ll_div8\n"
     ".type __ll_div8, @function\n"
     "__ll_div8:\n"
@@ -343,59 +342,6 @@ asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n" // with mul: one sh
     "movw r24, r30\n"
     "rjmp .Lmul_range\n"
     ".size _ZN2ll3Num3divERKS0_, .-_ZN2ll3Num3divERKS0_\n");
-
-// uint32_t Num::u32() const: floor(m * 2^e), saturated; whole bytes first.
-asm(".section .text._ZNK2ll3Num3u32Ev,\"ax\",@progbits\n"
-    ".global _ZNK2ll3Num3u32Ev\n"
-    ".type _ZNK2ll3Num3u32Ev, @function\n"
-    "_ZNK2ll3Num3u32Ev:\n"
-    "movw r30, r24\n"
-    "ld   r22, Z\n"
-    "ldd  r23, Z+1\n"
-    "ldd  r24, Z+2\n"
-    "ldd  r25, Z+3\n"
-    "ldd  r18, Z+4\n"
-    "tst  r25\n"
-    "breq .Lu32_zero\n"
-    "tst  r18\n"
-    "brmi .Lu32_shift\n"
-    "breq .Lu32_ret\n"
-    "ldi  r22, 0xFF\n" // e > 0: at least 2^32
-    "ldi  r23, 0xFF\n"
-    "movw r24, r22\n"
-    "ret\n"
-    ".Lu32_shift:\n"
-    "neg  r18\n"
-    "cpi  r18, 32\n"
-    "brsh .Lu32_zero\n"
-    ".Lu32_bytes:\n"
-    "cpi  r18, 8\n"
-    "brlo .Lu32_bits\n"
-    "mov  r22, r23\n"
-    "mov  r23, r24\n"
-    "mov  r24, r25\n"
-    "clr  r25\n"
-    "subi r18, 8\n"
-    "rjmp .Lu32_bytes\n"
-    ".Lu32_bits:\n"
-    "tst  r18\n"
-    "breq .Lu32_ret\n"
-    ".Lu32_bit:\n"
-    "lsr  r25\n"
-    "ror  r24\n"
-    "ror  r23\n"
-    "ror  r22\n"
-    "dec  r18\n"
-    "brne .Lu32_bit\n"
-    ".Lu32_ret:\n"
-    "ret\n"
-    ".Lu32_zero:\n"
-    "clr  r22\n"
-    "clr  r23\n"
-    "movw r24, r22\n"
-    "ret\n"
-    ".size _ZNK2ll3Num3u32Ev, .-_ZNK2ll3Num3u32Ev\n"
-    ".text\n");
 
 // Num num64(uint32_t hi, uint32_t lo, int8_t exp): hi in r22..r25, lo in r18..r21, exp in r16
 // (call-saved: read only); returns m in r18..r21 and e in r22. Whole bytes, then bits.
@@ -707,6 +653,8 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     ".Lmul_shr_go:\n"
     "call __ll_mul32s\n" // lo r18..r21, hi r22..r25
     "mov  r30, r13\n"
+    "pop  r13\n"
+    ".Lshr_sat:\n" // r18..r25 >> r30 (any count), saturated to 32 bits, into r22..r25
     "1:\n"
     "cpi  r30, 8\n"
     "brlo 2f\n"
@@ -744,9 +692,32 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "5:\n"
     "movw r22, r18\n"
     "movw r24, r20\n"
-    "pop  r13\n"
     "ret\n"
     ".size _ZN2ll7mul_shrEmmh, .-_ZN2ll7mul_shrEmmh\n"
+    // uint32_t Num::u32() const: floor(m 2^e), saturated. For e <= 0, m (as the low word of a
+    // 64-bit value) through mul_shr's shift: whole bytes, then bits.
+    ".global _ZNK2ll3Num3u32Ev\n"
+    ".type _ZNK2ll3Num3u32Ev, @function\n"
+    "_ZNK2ll3Num3u32Ev:\n"
+    "movw r30, r24\n"
+    "ld   r18, Z\n"
+    "ldd  r19, Z+1\n"
+    "ldd  r20, Z+2\n"
+    "ldd  r21, Z+3\n"
+    "ldd  r26, Z+4\n"
+    "cp   r1, r26\n"
+    "brlt 1f\n" // e > 0
+    "neg  r26\n"
+    "mov  r30, r26\n"
+    "clr  r22\n"
+    "clr  r23\n"
+    "movw r24, r22\n"
+    "rjmp .Lshr_sat\n"
+    "1:\n"
+    "tst  r21\n" // normalised: zero iff the top byte is
+    "breq .Lof_zero\n"
+    "rjmp .Lof_sat\n" // at least 2^32
+    ".size _ZNK2ll3Num3u32Ev, .-_ZNK2ll3Num3u32Ev\n"
     ".text\n");
 
 // Num& Num::shift(int8_t k): k in r22; e += k unless the value is zero.
