@@ -294,9 +294,26 @@ uint32_t div32_16(uint32_t n, uint16_t d) {
 }
 #endif
 
+#if defined(__AVR__)
+// a in r22..r25, b in r18..r21, &lo in r16:r17 (kept by __ll_mul32s); hi returned in r22..r25.
+asm(".section .text._ZN2ll8mul_wideEmmRm,\"ax\",@progbits\n"
+    ".global _ZN2ll8mul_wideEmmRm\n"
+    ".type _ZN2ll8mul_wideEmmRm, @function\n"
+    "_ZN2ll8mul_wideEmmRm:\n"
+    "call __ll_mul32s\n"
+    "movw r30, r16\n"
+    "st   Z, r18\n"
+    "std  Z+1, r19\n"
+    "std  Z+2, r20\n"
+    "std  Z+3, r21\n"
+    "ret\n"
+    ".size _ZN2ll8mul_wideEmmRm, .-_ZN2ll8mul_wideEmmRm\n"
+    ".text\n");
+#else
 uint32_t mul_wide(uint32_t a, uint32_t b, uint32_t& lo) {
     return mul64(a, b, lo);
 }
+#endif
 
 uint32_t shr64_sat(uint32_t hi, uint32_t lo, uint8_t shift) {
     return shr_sat(hi, lo, shift);
