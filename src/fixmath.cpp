@@ -629,6 +629,7 @@ Num& Num::sqrt() {
 
 #endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask) {
     // Exact 64-bit sums while every value is below 2^30 (6 squares below 2^63); larger values
     // (travel beyond 4 km) lose their two low bits first.
@@ -648,6 +649,7 @@ Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask) {
     }
     return num64(hi, lo, static_cast<int8_t>(2 * drop));
 }
+#endif
 
 #if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num num64(uint32_t hi, uint32_t lo, int8_t exp) {

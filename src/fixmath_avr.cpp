@@ -1076,4 +1076,91 @@ asm(".section .progmem.data.__ll_atan_q29,\"a\",@progbits\n"
     ".size _ZN2ll9atan2_q29Ell, .-_ZN2ll9atan2_q29Ell\n"
     ".text\n");
 
+// Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask): v in r24:r25, n in r22, mask in
+// r20; the Num in r18..r22 as num64 returns it. fixmath.cpp's C in one routine: the top bytes of
+// all n values ORed (any >= 0x40: every value loses two bits, exp 4), then the squares of the
+// masked values summed exactly in r2..r9 (squares of zero add nothing: no test) and num64. The
+// registers are saved by libgcc's __prologue_saves__ (Y the frame pointer for the restore).
+asm(".section .text._ZN2ll11sum_squaresEPKmhh,\"ax\",@progbits\n"
+    ".global _ZN2ll11sum_squaresEPKmhh\n"
+    ".type _ZN2ll11sum_squaresEPKmhh, @function\n"
+    "_ZN2ll11sum_squaresEPKmhh:\n"
+    "ldi  r26, 0\n" // no frame
+    "ldi  r27, 0\n"
+    "ldi  r30, lo8(pm(.Lss_body))\n"
+    "ldi  r31, hi8(pm(.Lss_body))\n"
+    "jmp  __prologue_saves__\n" // r2..r17, r28, r29
+    ".Lss_body:\n"
+    "movw r12, r24\n" // v
+    "mov  r10, r22\n" // n
+    "mov  r11, r20\n" // mask
+    "clr  r16\n"      // exp: 0, or 4 when two bits are dropped
+    "tst  r10\n"
+    "breq 3f\n"
+    "movw r30, r24\n"
+    "mov  r26, r22\n"
+    "clr  r0\n"
+    "1:\n"
+    "ldd  r27, Z+3\n"
+    "or   r0, r27\n"
+    "adiw r30, 4\n"
+    "dec  r26\n"
+    "brne 1b\n"
+    "mov  r27, r0\n"
+    "andi r27, 0xC0\n"
+    "breq 3f\n"
+    "ldi  r16, 4\n"
+    "3:\n"
+    "clr  r2\n" // lo in r2..r5, hi in r6..r9
+    "clr  r3\n"
+    "movw r4, r2\n"
+    "movw r6, r2\n"
+    "movw r8, r2\n"
+    "rjmp 7f\n"
+    "4:\n"
+    "movw r30, r12\n"
+    "ld   r18, Z+\n"
+    "ld   r19, Z+\n"
+    "ld   r20, Z+\n"
+    "ld   r21, Z+\n"
+    "movw r12, r30\n"
+    "lsr  r11\n"
+    "brcc 6f\n" // not in the mask
+    "tst  r16\n"
+    "breq 5f\n"
+    "lsr  r21\n"
+    "ror  r20\n"
+    "ror  r19\n"
+    "ror  r18\n"
+    "lsr  r21\n"
+    "ror  r20\n"
+    "ror  r19\n"
+    "ror  r18\n"
+    "5:\n"
+    "movw r22, r18\n"
+    "movw r24, r20\n"
+    "call __ll_mul32s\n" // lo r18..r21, hi r22..r25
+    "add  r2, r18\n"
+    "adc  r3, r19\n"
+    "adc  r4, r20\n"
+    "adc  r5, r21\n"
+    "adc  r6, r22\n"
+    "adc  r7, r23\n"
+    "adc  r8, r24\n"
+    "adc  r9, r25\n"
+    "6:\n"
+    "dec  r10\n"
+    "7:\n"
+    "tst  r10\n"
+    "brne 4b\n"
+    "movw r18, r2\n"
+    "movw r20, r4\n"
+    "movw r22, r6\n"
+    "movw r24, r8\n"
+    "call _ZN2ll5num64Emma\n" // exp in r16
+    "ldi  r30, 18\n"
+    "jmp  __epilogue_restores__\n"
+    ".size _ZN2ll11sum_squaresEPKmhh, .-_ZN2ll11sum_squaresEPKmhh\n"
+    ".text\n");
+
 #endif // __AVR__

@@ -75,6 +75,8 @@ inline uint32_t fixmath_hash(uint16_t rounds) {
                     static_cast<int8_t>(static_cast<int16_t>(xorshift(s) % 80) - 40)));
         uint32_t v[4] = {any(s), any(s), 0, any(s) >> (xorshift(s) & 7)};
         h.add(sum_squares(v, 4));
+        h.add(sum_squares(v, static_cast<uint8_t>(xorshift(s) % 5),
+                          static_cast<uint8_t>(xorshift(s))));
         h.add(div32_16(any(s), static_cast<uint16_t>((any(s) & 0xFFFF) | 1)));
         // Zeros and equal exponents.
         Num z(0), w = x;
