@@ -84,7 +84,11 @@ bool length_to_milli(const Decimal& d, bool inches, int32_t& out) {
 }
 
 bool to_uint(const Decimal& d, uint32_t max, uint32_t& out) {
-    if (d.negative() || !d.integral() || d.ipart > max) return false;
+    // Not negative and integral, in one test of the flags.
+    if ((d.flags & (Decimal::kNegative | Decimal::kInexact)) != 0 || (d.frac | d.sub) != 0 ||
+        d.ipart > max) {
+        return false;
+    }
     out = d.ipart;
     return true;
 }
