@@ -1,9 +1,11 @@
-// The hot Num operations in AVR assembly (the portable C versions are in fixmath.cpp, built
-// for the host; tools/test_fixmath_avr.cpp checks that both give the same bits). Each routine
-// has the C++ symbol of the method it implements and follows avr-gcc's calling convention
-// (this in r24:r25, arguments from r22 down, r2..r17 and r28:r29 preserved, r1 = 0), so the
-// header declares them as ordinary members. Written in assembly because avr-gcc 5.4 spends more
-// cycles in prologues, 32-bit shifts and byte shuffles than in the arithmetic itself.
+// The hot Num operations (and sum_squares, atan2_q29) in AVR assembly (the portable C versions
+// are in fixmath.cpp, built for the host; tools/test_fixmath_avr.cpp checks that both give the
+// same bits). Each routine follows avr-gcc's calling convention (this in r24:r25, arguments from
+// r22 down, r2..r17 and r28:r29 preserved, r1 = 0) and has the C++ symbol of the function it
+// implements, so the header declares them as ordinary members; set, mul(uint32_t) and
+// div(uint32_t) have __ll_ entries instead, which fixmath.h's inline members choose between
+// (shorter ones for constant arguments). Written in assembly because avr-gcc 5.4 spends more
+// cycles and bytes in prologues, 32-bit shifts and byte shuffles than in the arithmetic itself.
 #include "lowlevel/fixmath.h"
 
 #if defined(__AVR__)
