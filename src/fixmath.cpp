@@ -13,7 +13,21 @@ namespace {
 // r27, r30, r31 and r0 (r1 back to zero). Column k of the byte products (i + j = k) is summed
 // into a 3-byte window (a column's sum plus the carry from below stays under 2^24), whose low
 // byte is then final: result byte k.
+// __ll_mul32s: the same keeping r14..r17, for the assembly routines whose own operands are there
+// or that would otherwise save them (4 pushes here instead of in each caller).
 asm(".section .text.__ll_mul32,\"ax\",@progbits\n"
+    ".global __ll_mul32s\n"
+    "__ll_mul32s:\n"
+    "push r14\n"
+    "push r15\n"
+    "push r16\n"
+    "push r17\n"
+    "rcall __ll_mul32\n"
+    "pop  r17\n"
+    "pop  r16\n"
+    "pop  r15\n"
+    "pop  r14\n"
+    "ret\n"
     ".global __ll_mul32\n"
     "__ll_mul32:\n"
     "movw r26, r18\n"
@@ -228,56 +242,13 @@ uint16_t isqrt32(uint32_t v) {
 #endif
 }
 
+#if !defined(__AVR__) // AVR: Num::sqrt in fixmath_avr.cpp
 namespace {
 
 // floor(rem * 2^15 / s) for 2^15 <= s < 2^16 and rem <= 2 s: the Newton correction of a
 // square root (a quotient below 2^17).
 uint32_t sqrt_step(uint32_t rem, uint16_t s) {
     // rem = q0 s + r with q0 <= 2, then 15 quotient bits of r * 2^15 / s.
-#if defined(__AVR__)
-    // One block: q0 counted into the quotient's low byte, which the 15 turns then shift up to
-    // bits 15..16 (a 3-byte quotient; its top byte stays zero).
-    uint32_t q;
-    uint8_t n;
-    asm("clr  %A[q]\n\t"
-        "clr  %B[q]\n\t"
-        "clr  %C[q]\n\t"
-        "clr  %D[q]\n"
-        "0:\n\t"
-        "cp   %A[r], %A[s]\n\t"
-        "cpc  %B[r], %B[s]\n\t"
-        "cpc  %C[r], __zero_reg__\n\t"
-        "cpc  %D[r], __zero_reg__\n\t"
-        "brcs 4f\n\t"
-        "sub  %A[r], %A[s]\n\t"
-        "sbc  %B[r], %B[s]\n\t"
-        "sbc  %C[r], __zero_reg__\n\t"
-        "sbc  %D[r], __zero_reg__\n\t"
-        "inc  %A[q]\n\t"
-        "rjmp 0b\n"
-        "4:\n\t"
-        "ldi  %[n], 15\n"
-        "1:\n\t"
-        "lsl  %A[q]\n\t"
-        "rol  %B[q]\n\t"
-        "rol  %C[q]\n\t"
-        "lsl  %A[r]\n\t"
-        "rol  %B[r]\n\t"
-        "brcs 2f\n\t"
-        "cp   %A[r], %A[s]\n\t"
-        "cpc  %B[r], %B[s]\n\t"
-        "brcs 3f\n"
-        "2:\n\t"
-        "sub  %A[r], %A[s]\n\t"
-        "sbc  %B[r], %B[s]\n\t"
-        "inc  %A[q]\n"
-        "3:\n\t"
-        "dec  %[n]\n\t"
-        "brne 1b"
-        : [q] "=&r"(q), [r] "+r"(rem), [n] "=&d"(n)
-        : [s] "r"(s));
-    return q;
-#else
     uint8_t q0 = 0;
     while (rem >= s) {
         rem -= s;
@@ -295,10 +266,10 @@ uint32_t sqrt_step(uint32_t rem, uint16_t s) {
         }
     }
     return static_cast<uint32_t>(q0) << 15 | q;
-#endif
 }
 
 } // namespace
+#endif
 
 uint32_t div_frac(uint32_t num, uint32_t den, uint8_t bits) {
     uint32_t q = 0, rem = num;
@@ -323,9 +294,26 @@ uint32_t div32_16(uint32_t n, uint16_t d) {
 }
 #endif
 
+#if defined(__AVR__)
+// a in r22..r25, b in r18..r21, &lo in r16:r17 (kept by __ll_mul32s); hi returned in r22..r25.
+asm(".section .text._ZN2ll8mul_wideEmmRm,\"ax\",@progbits\n"
+    ".global _ZN2ll8mul_wideEmmRm\n"
+    ".type _ZN2ll8mul_wideEmmRm, @function\n"
+    "_ZN2ll8mul_wideEmmRm:\n"
+    "call __ll_mul32s\n"
+    "movw r30, r16\n"
+    "st   Z, r18\n"
+    "std  Z+1, r19\n"
+    "std  Z+2, r20\n"
+    "std  Z+3, r21\n"
+    "ret\n"
+    ".size _ZN2ll8mul_wideEmmRm, .-_ZN2ll8mul_wideEmmRm\n"
+    ".text\n");
+#else
 uint32_t mul_wide(uint32_t a, uint32_t b, uint32_t& lo) {
     return mul64(a, b, lo);
 }
+#endif
 
 uint32_t shr64_sat(uint32_t hi, uint32_t lo, uint8_t shift) {
     return shr_sat(hi, lo, shift);
@@ -379,11 +367,13 @@ uint32_t shl_sat(uint32_t x, uint8_t k) {
 
 namespace {
 
+#if !defined(__AVR__) // AVR: atan2_q29 in fixmath_avr.cpp, with its copy
 // atan(2^-i) in radians x 2^29 for i <= 10; beyond, atan(2^-i) = 2^-i to the last bit (and
 // 2^-10 already is: the last entry is 2^19, halved from there on).
 const uint32_t kAtanQ29[11] LL_PROGMEM = {421657428, 248918915, 131521918, 66762579,
                                           33510843,  16771758,  8387925,   4194219,
                                           2097141,   1048575,   524288};
+#endif
 
 // (a * b) >> 30 for Q30 operands (the arithmetic shift of the exact 64-bit product). From the
 // unsigned product: a negative operand subtracts the other one times 2^32.
@@ -403,6 +393,7 @@ int32_t horner(int32_t x, int32_t r, int32_t t) {
 
 } // namespace
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 int32_t atan2_q29(int32_t y, int32_t x) {
     if (x == 0 && y == 0) return 0;
     // Bring the vector into the right half plane with a quarter turn, then normalise it to
@@ -432,101 +423,6 @@ int32_t atan2_q29(int32_t y, int32_t x) {
         y *= 2;
         big <<= 1;
     }
-#if defined(__AVR__)
-    // The same 30 turns with one 4-byte temporary: x >> i (or y >> i) is applied first, and
-    // the other operand's old value is then recovered from the new one (t + y' = y, t + x' = x)
-    // before its own shift. One shift loop, called twice per turn.
-    uint32_t a, t;
-    uint8_t i, n;
-    const uint32_t* tab = kAtanQ29;
-    asm("clr  %[i]\n"
-        "0:\n\t"
-        "cpi  %[i], 11\n\t"
-        "brsh 1f\n\t"
-        "lpm  %A[a], Z+\n\t"
-        "lpm  %B[a], Z+\n\t"
-        "lpm  %C[a], Z+\n\t"
-        "lpm  %D[a], Z+\n\t"
-        "rjmp 2f\n"
-        "1:\n\t"
-        "lsr  %D[a]\n\t"
-        "ror  %C[a]\n\t"
-        "ror  %B[a]\n\t"
-        "ror  %A[a]\n"
-        "2:\n\t"
-        "sbrc %D[y], 7\n\t"
-        "rjmp 3f\n\t"
-        "cp   %A[y], __zero_reg__\n\t"
-        "cpc  %B[y], __zero_reg__\n\t"
-        "cpc  %C[y], __zero_reg__\n\t"
-        "cpc  %D[y], __zero_reg__\n\t"
-        "breq 3f\n\t"
-        // y > 0: y -= x >> i, x += y >> i (old y), z += a
-        "movw %A[t], %A[x]\n\t"
-        "movw %C[t], %C[x]\n\t"
-        "rcall 5f\n\t"
-        "sub  %A[y], %A[t]\n\t"
-        "sbc  %B[y], %B[t]\n\t"
-        "sbc  %C[y], %C[t]\n\t"
-        "sbc  %D[y], %D[t]\n\t"
-        "add  %A[t], %A[y]\n\t"
-        "adc  %B[t], %B[y]\n\t"
-        "adc  %C[t], %C[y]\n\t"
-        "adc  %D[t], %D[y]\n\t"
-        "rcall 5f\n\t"
-        "add  %A[x], %A[t]\n\t"
-        "adc  %B[x], %B[t]\n\t"
-        "adc  %C[x], %C[t]\n\t"
-        "adc  %D[x], %D[t]\n\t"
-        "add  %A[z], %A[a]\n\t"
-        "adc  %B[z], %B[a]\n\t"
-        "adc  %C[z], %C[a]\n\t"
-        "adc  %D[z], %D[a]\n\t"
-        "rjmp 4f\n"
-        // y <= 0: x -= y >> i, y += x >> i (old x), z -= a
-        "3:\n\t"
-        "movw %A[t], %A[y]\n\t"
-        "movw %C[t], %C[y]\n\t"
-        "rcall 5f\n\t"
-        "sub  %A[x], %A[t]\n\t"
-        "sbc  %B[x], %B[t]\n\t"
-        "sbc  %C[x], %C[t]\n\t"
-        "sbc  %D[x], %D[t]\n\t"
-        "add  %A[t], %A[x]\n\t"
-        "adc  %B[t], %B[x]\n\t"
-        "adc  %C[t], %C[x]\n\t"
-        "adc  %D[t], %D[x]\n\t"
-        "rcall 5f\n\t"
-        "add  %A[y], %A[t]\n\t"
-        "adc  %B[y], %B[t]\n\t"
-        "adc  %C[y], %C[t]\n\t"
-        "adc  %D[y], %D[t]\n\t"
-        "sub  %A[z], %A[a]\n\t"
-        "sbc  %B[z], %B[a]\n\t"
-        "sbc  %C[z], %C[a]\n\t"
-        "sbc  %D[z], %D[a]\n"
-        "4:\n\t"
-        "inc  %[i]\n\t"
-        "cpi  %[i], 30\n\t"
-        "brlo 0b\n\t"
-        "rjmp 7f\n"
-        // t >>= i, arithmetic
-        "5:\n\t"
-        "mov  %[n], %[i]\n\t"
-        "rjmp 6f\n"
-        "8:\n\t"
-        "asr  %D[t]\n\t"
-        "ror  %C[t]\n\t"
-        "ror  %B[t]\n\t"
-        "ror  %A[t]\n"
-        "6:\n\t"
-        "dec  %[n]\n\t"
-        "brpl 8b\n\t"
-        "ret\n"
-        "7:"
-        : [x] "+r"(x), [y] "+r"(y), [z] "+r"(z), [a] "=&r"(a), [t] "=&r"(t), [i] "=&d"(i),
-          [n] "=&r"(n), "+z"(tab));
-#else
     uint32_t a = 0;
     for (uint8_t i = 0; i < 30; ++i) {
         a = i <= 10 ? flash_read_u32(&kAtanQ29[i]) : a >> 1;
@@ -541,9 +437,9 @@ int32_t atan2_q29(int32_t y, int32_t x) {
             z -= static_cast<int32_t>(a);
         }
     }
-#endif
     return z;
 }
+#endif
 
 void small_angle_q30(int32_t h, int32_t& c, int32_t& s, int32_t& k) {
     // Reciprocals 1/n in Q30 for the series' coefficient ratios.
@@ -701,6 +597,7 @@ Num& Num::add(const Num& o) {
 }
 #endif
 
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num& Num::sqrt() {
     if (m == 0) return *this;
     // Make the exponent even: value = m' * 2^e' with m' in [2^30, 2^32).
@@ -730,6 +627,9 @@ Num& Num::sqrt() {
     return *this;
 }
 
+#endif
+
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask) {
     // Exact 64-bit sums while every value is below 2^30 (6 squares below 2^63); larger values
     // (travel beyond 4 km) lose their two low bits first.
@@ -749,6 +649,7 @@ Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask) {
     }
     return num64(hi, lo, static_cast<int8_t>(2 * drop));
 }
+#endif
 
 #if !defined(__AVR__) // AVR: fixmath_avr.cpp
 Num num64(uint32_t hi, uint32_t lo, int8_t exp) {
@@ -759,6 +660,13 @@ Num num64(uint32_t hi, uint32_t lo, int8_t exp) {
     uint8_t k = static_cast<uint8_t>(32 + exp - r.e);
     if (k) r.m |= shr_sat(0, lo, static_cast<uint8_t>(32 - k));
     return r;
+}
+#endif
+
+#if !defined(__AVR__) // AVR: fixmath_avr.cpp
+Num& Num::shift(int8_t k) {
+    if (m) e = static_cast<int8_t>(e + k);
+    return *this;
 }
 #endif
 

@@ -43,12 +43,13 @@ const char* parse(const char* p, Decimal& out) {
         }
         // Decimals 1-3 make `frac` (0..999), 4-5 `sub` (0..99), each weighted by its place.
         static const uint8_t kWeight[5] LL_PROGMEM = {100, 10, 1, 10, 1};
-        if (place < 3) {
-            frac = static_cast<uint16_t>(
-                frac + static_cast<uint16_t>(d * flash_read_byte(&kWeight[place])));
-        } else if (place < 5) {
-            sub = static_cast<uint8_t>(sub +
-                                       static_cast<uint8_t>(d * flash_read_byte(&kWeight[place])));
+        if (place < 5) {
+            uint16_t dw = static_cast<uint16_t>(d * flash_read_byte(&kWeight[place]));
+            if (place < 3) {
+                frac = static_cast<uint16_t>(frac + dw);
+            } else {
+                sub = static_cast<uint8_t>(sub + dw);
+            }
         } else {
             if (place == 5 && d >= 5) flags |= Decimal::kRound6;
             if (d != 0) flags |= Decimal::kInexact;
@@ -83,7 +84,11 @@ bool length_to_milli(const Decimal& d, bool inches, int32_t& out) {
 }
 
 bool to_uint(const Decimal& d, uint32_t max, uint32_t& out) {
-    if (d.negative() || !d.integral() || d.ipart > max) return false;
+    // Not negative and integral, in one test of the flags.
+    if ((d.flags & (Decimal::kNegative | Decimal::kInexact)) != 0 || (d.frac | d.sub) != 0 ||
+        d.ipart > max) {
+        return false;
+    }
     out = d.ipart;
     return true;
 }
@@ -93,50 +98,120 @@ bool to_uint(const Decimal& d, uint32_t max, uint32_t& out) {
 // overflows as r < 2^31). While r < c / 256, the next 8 quotient bits are zero: those are
 // taken a byte at a time (a position in um times steps/um usually needs 12 to 20 bit turns).
 // The chip gets the same algorithm in assembly: 19 cycles a bit instead of 40.
-inline void divide(uint32_t& r, uint32_t& q, uint32_t c) {
-#ifdef __AVR__
-    uint8_t k;
-    asm("ldi %[k], 32\n\t"
-        "0: cpi %[k], 9\n\t" // bytes: while k > 8 and r < c >> 8
-        "brlo 1f\n\t"
-        "cp %A[r], %B[c]\n\t"
-        "cpc %B[r], %C[c]\n\t"
-        "cpc %C[r], %D[c]\n\t"
-        "cpc %D[r], __zero_reg__\n\t"
-        "brsh 1f\n\t"
-        "mov %D[r], %C[r]\n\t"
-        "mov %C[r], %B[r]\n\t"
-        "mov %B[r], %A[r]\n\t"
-        "mov %A[r], %D[q]\n\t"
-        "mov %D[q], %C[q]\n\t"
-        "mov %C[q], %B[q]\n\t"
-        "mov %B[q], %A[q]\n\t"
-        "clr %A[q]\n\t"
-        "subi %[k], 8\n\t"
-        "rjmp 0b\n\t"
-        "1: lsl %A[q]\n\t" // bits
-        "rol %B[q]\n\t"
-        "rol %C[q]\n\t"
-        "rol %D[q]\n\t"
-        "rol %A[r]\n\t"
-        "rol %B[r]\n\t"
-        "rol %C[r]\n\t"
-        "rol %D[r]\n\t"
-        "cp %A[r], %A[c]\n\t"
-        "cpc %B[r], %B[c]\n\t"
-        "cpc %C[r], %C[c]\n\t"
-        "cpc %D[r], %D[c]\n\t"
-        "brlo 2f\n\t"
-        "sub %A[r], %A[c]\n\t"
-        "sbc %B[r], %B[c]\n\t"
-        "sbc %C[r], %C[c]\n\t"
-        "sbc %D[r], %D[c]\n\t"
-        "ori %A[q], 1\n\t"
-        "2: dec %[k]\n\t"
-        "brne 1b"
-        : [r] "+r"(r), [q] "+d"(q), [k] "=&d"(k)
-        : [c] "r"(c));
+#if defined(__AVR__)
+// mul_div_round on the chip, as one routine (the portable C below is the reference: the host
+// tests check it, and tools/fixmath_check.h compares both): a in r22..r25, b in r18..r21, c in
+// r14..r17 (kept by __ll_mul32s), &out in r12:r13; true/false in r24. The sign in T, the
+// magnitude's product by __ll_mul32s (fixmath.cpp), + c/2, then divide().
+asm(".section .text._ZN2ll3num13mul_div_roundElmmRl,\"ax\",@progbits\n"
+    ".global _ZN2ll3num13mul_div_roundElmmRl\n"
+    ".type _ZN2ll3num13mul_div_roundElmmRl, @function\n"
+    "_ZN2ll3num13mul_div_roundElmmRl:\n"
+    "bst  r25, 7\n" // T: a < 0
+    "brtc 1f\n"
+    "com  r25\n"
+    "com  r24\n"
+    "com  r23\n"
+    "neg  r22\n"
+    "sbci r23, 0xFF\n"
+    "sbci r24, 0xFF\n"
+    "sbci r25, 0xFF\n"
+    "1:\n"
+    "call __ll_mul32s\n" // q (low word) in r18..r21, r (high word) in r22..r25
+    "movw r26, r14\n"    // + c/2, half away from zero on the magnitude
+    "movw r30, r16\n"
+    "lsr  r31\n"
+    "ror  r30\n"
+    "ror  r27\n"
+    "ror  r26\n"
+    "add  r18, r26\n"
+    "adc  r19, r27\n"
+    "adc  r20, r30\n"
+    "adc  r21, r31\n"
+    "adc  r22, r1\n" // r <= 2^32 - 2: no carry out
+    "adc  r23, r1\n"
+    "adc  r24, r1\n"
+    "adc  r25, r1\n"
+    "cp   r22, r14\n" // r >= c: the quotient needs more than 32 bits
+    "cpc  r23, r15\n"
+    "cpc  r24, r16\n"
+    "cpc  r25, r17\n"
+    "brsh .Lmdr_over\n"
+    "ldi  r26, 32\n"
+    "2:\n" // bytes: while k > 8 and r < c >> 8
+    "cpi  r26, 9\n"
+    "brlo 3f\n"
+    "cp   r22, r15\n"
+    "cpc  r23, r16\n"
+    "cpc  r24, r17\n"
+    "cpc  r25, r1\n"
+    "brsh 3f\n"
+    "mov  r25, r24\n"
+    "mov  r24, r23\n"
+    "mov  r23, r22\n"
+    "mov  r22, r21\n"
+    "mov  r21, r20\n"
+    "mov  r20, r19\n"
+    "mov  r19, r18\n"
+    "clr  r18\n"
+    "subi r26, 8\n"
+    "rjmp 2b\n"
+    "3:\n" // bits
+    "lsl  r18\n"
+    "rol  r19\n"
+    "rol  r20\n"
+    "rol  r21\n"
+    "rol  r22\n"
+    "rol  r23\n"
+    "rol  r24\n"
+    "rol  r25\n"
+    "cp   r22, r14\n"
+    "cpc  r23, r15\n"
+    "cpc  r24, r16\n"
+    "cpc  r25, r17\n"
+    "brlo 4f\n"
+    "sub  r22, r14\n"
+    "sbc  r23, r15\n"
+    "sbc  r24, r16\n"
+    "sbc  r25, r17\n"
+    "ori  r18, 1\n"
+    "4:\n"
+    "dec  r26\n"
+    "brne 3b\n"
+    "sbrc r21, 7\n" // above INT32_MAX
+    "rjmp .Lmdr_over\n"
+    "brtc 5f\n"
+    "com  r21\n"
+    "com  r20\n"
+    "com  r19\n"
+    "neg  r18\n"
+    "sbci r19, 0xFF\n"
+    "sbci r20, 0xFF\n"
+    "sbci r21, 0xFF\n"
+    "5:\n"
+    "ldi  r24, 1\n"
+    "6:\n"
+    "movw r30, r12\n"
+    "st   Z, r18\n"
+    "std  Z+1, r19\n"
+    "std  Z+2, r20\n"
+    "std  Z+3, r21\n"
+    "ret\n"
+    ".Lmdr_over:\n" // INT32_MIN or INT32_MAX by the sign
+    "ldi  r18, 0xFF\n"
+    "ldi  r21, 0x7F\n"
+    "brtc 7f\n"
+    "clr  r18\n"
+    "ldi  r21, 0x80\n"
+    "7:\n"
+    "mov  r19, r18\n"
+    "mov  r20, r18\n"
+    "clr  r24\n"
+    "rjmp 6b\n"
+    ".size _ZN2ll3num13mul_div_roundElmmRl, .-_ZN2ll3num13mul_div_roundElmmRl\n"
+    ".text\n");
 #else
+inline void divide(uint32_t& r, uint32_t& q, uint32_t c) {
     uint8_t k = 32;
     while (k > 8 && r < (c >> 8)) {
         r = (r << 8) | (q >> 24);
@@ -151,7 +226,6 @@ inline void divide(uint32_t& r, uint32_t& q, uint32_t c) {
             q |= 1u;
         }
     } while (--k != 0);
-#endif
 }
 
 bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out) {
@@ -169,6 +243,7 @@ bool mul_div_round(int32_t a, uint32_t b, uint32_t c, int32_t& out) {
     out = static_cast<int32_t>(negative ? 0x80000000u : kInt32Max);
     return false;
 }
+#endif
 
 } // namespace num
 } // namespace ll

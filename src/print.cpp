@@ -9,16 +9,25 @@ namespace ll {
 namespace out {
 
 namespace {
-const uint32_t kPow10[10] LL_PROGMEM = {1u,      10u,      100u,      1000u,      10000u,
-                                        100000u, 1000000u, 10000000u, 100000000u, 1000000000u};
+// Descending: digits() reads it forward, one power per digit.
+const uint32_t kPow10[10] LL_PROGMEM = {1000000000u, 100000000u, 10000000u, 1000000u, 100000u,
+                                        10000u,      1000u,      100u,      10u,      1u};
 
-// Digits of m, with at least `decimals + 1` of them and a point before the last `decimals`.
+constexpr uint8_t kMinus = 0x80; // in digits()' `decimals`: a '-' first
+
+// Digits of m, with at least `decimals + 1` of them and a point before the last `decimals`
+// (after a '-' when kMinus is set in `decimals`).
 void digits(uint32_t m, uint8_t decimals) {
+    if (decimals & kMinus) {
+        ch('-');
+        decimals = static_cast<uint8_t>(decimals & ~kMinus);
+    }
     bool started = false;
+    const uint32_t* next = kPow10;
     uint8_t p = 10;
     do {
         --p;
-        uint32_t pw = flash_read_u32(&kPow10[p]);
+        uint32_t pw = flash_read_u32(next++); // 10^p
         char d = '0';
         while (m >= pw) {
             m -= pw;
@@ -76,10 +85,11 @@ void word(char letter, uint8_t v) {
 }
 
 void fixed(int32_t v, uint8_t decimals) {
+    // The sign goes to digits() with the count: v need not outlive a call here.
     uint32_t m = static_cast<uint32_t>(v);
     if (v < 0) {
-        ch('-');
         m = 0u - m;
+        decimals = static_cast<uint8_t>(decimals | kMinus);
     }
     digits(m, decimals);
 }

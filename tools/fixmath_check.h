@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "lowlevel/fixmath.h"
+#include "lowlevel/numparse.h"
 
 namespace ll {
 namespace check {
@@ -74,6 +75,8 @@ inline uint32_t fixmath_hash(uint16_t rounds) {
                     static_cast<int8_t>(static_cast<int16_t>(xorshift(s) % 80) - 40)));
         uint32_t v[4] = {any(s), any(s), 0, any(s) >> (xorshift(s) & 7)};
         h.add(sum_squares(v, 4));
+        h.add(sum_squares(v, static_cast<uint8_t>(xorshift(s) % 5),
+                          static_cast<uint8_t>(xorshift(s))));
         h.add(div32_16(any(s), static_cast<uint16_t>((any(s) & 0xFFFF) | 1)));
         // Zeros and equal exponents.
         Num z(0), w = x;
@@ -94,6 +97,12 @@ inline uint32_t fixmath_hash(uint16_t rounds) {
         h.add(shl_sat(any(s), static_cast<uint8_t>(xorshift(s) % 40)));
         h.add(Num(x).mulc(a | 0x80000000ul,
                           static_cast<int8_t>(static_cast<int16_t>(xorshift(s) % 100) - 50)));
+        // mul_div_round: both signs, results in and out of range, small and large divisors.
+        int32_t md = static_cast<int32_t>(any(s));
+        if (xorshift(s) & 1) md = static_cast<int32_t>(0u - static_cast<uint32_t>(md));
+        int32_t mdo = 0;
+        bool mdok = num::mul_div_round(md, any(s), (any(s) & 0x7FFFFFFFul) | 1, mdo);
+        h.add(static_cast<uint32_t>(mdo) ^ (mdok ? 0x80000000ul : 0));
         // atan2 in every quadrant, on both axes and at every magnitude (|v| < 2^30).
         int32_t ya = static_cast<int32_t>(any(s) >> 2), xa = static_cast<int32_t>(any(s) >> 2);
         uint32_t signs = xorshift(s);

@@ -29,7 +29,7 @@ struct Decimal {
 
     bool negative() const { return (flags & kNegative) != 0; }
     /// True when the value has no non-zero decimal at all.
-    bool integral() const { return frac == 0 && sub == 0 && (flags & kInexact) == 0; }
+    bool integral() const { return (frac | sub | (flags & kInexact)) == 0; }
 };
 
 /// Reads `[+|-]digits[.digits]` (at least one digit; GRBL's read_float without its float) at
