@@ -25,9 +25,55 @@ constexpr uint32_t kTurnQ29 = 2ul * kPiQ29;
 // 0.02 tick.
 constexpr uint32_t kMaxPieceTicks = 2000;
 
-// floor(a b / 2^s), the result within 32 bits.
+// floor(a b / 2^s) for s <= 32, the result within 32 bits.
 __attribute__((noinline)) int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
+#if defined(__AVR__)
+    // The unsigned product of fixmath's multiplier made signed (a negative factor as the unsigned
+    // one less 2^32), then the bits s to s + 31 of the 64-bit word, whole bytes by moves first:
+    // avr-gcc would call its 64-bit product routines, which nothing else in the image needs.
+    // (Bits shifted in at the top never reach the low word for s <= 32.)
+    uint32_t corr = 0;
+    if (a < 0) corr += static_cast<uint32_t>(b);
+    if (b < 0) corr += static_cast<uint32_t>(a);
+    register uint32_t hi asm("r22") = static_cast<uint32_t>(a);
+    register uint32_t lo asm("r18") = static_cast<uint32_t>(b);
+    asm("call __ll_mul32" // fixmath.cpp: the product in (hi, lo)
+        : "+r"(hi), "+r"(lo)
+        :
+        : "r14", "r15", "r16", "r17", "r26", "r27", "r30", "r31");
+    hi -= corr;
+    asm("1:\n\t"
+        "cpi  %[s], 8\n\t"
+        "brlo 2f\n\t"
+        "mov  %A[lo], %B[lo]\n\t"
+        "mov  %B[lo], %C[lo]\n\t"
+        "mov  %C[lo], %D[lo]\n\t"
+        "mov  %D[lo], %A[hi]\n\t"
+        "mov  %A[hi], %B[hi]\n\t"
+        "mov  %B[hi], %C[hi]\n\t"
+        "mov  %C[hi], %D[hi]\n\t"
+        "subi %[s], 8\n\t"
+        "rjmp 1b\n"
+        "2:\n\t"
+        "tst  %[s]\n\t"
+        "breq 4f\n"
+        "3:\n\t"
+        "lsr  %D[hi]\n\t"
+        "ror  %C[hi]\n\t"
+        "ror  %B[hi]\n\t"
+        "ror  %A[hi]\n\t"
+        "ror  %D[lo]\n\t"
+        "ror  %C[lo]\n\t"
+        "ror  %B[lo]\n\t"
+        "ror  %A[lo]\n\t"
+        "dec  %[s]\n\t"
+        "brne 3b\n"
+        "4:"
+        : [hi] "+r"(hi), [lo] "+r"(lo), [s] "+d"(s));
+    return static_cast<int32_t>(lo);
+#else
     return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> s);
+#endif
 }
 
 // (a b) >> 30: products of Q30 factors, and Q8 coordinates times Q30 factors.
