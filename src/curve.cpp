@@ -76,6 +76,22 @@ __attribute__((noinline)) int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
 #endif
 }
 
+// avr-gcc's -mcall-prologues saves and restores registers through the shared
+// __prologue_saves__ / __epilogue_restores__ only when the saved ones form a single run ending at
+// r17; otherwise each function pushes and pops them one by one (and sets up its frame in line).
+// These empty statements mark the gap of a function's run as used: a few bytes of stack for
+// 40 to 80 bytes of code.
+__attribute__((always_inline)) inline void save_run_from_r8() {
+#if defined(__AVR__)
+    asm volatile("" ::: "r8", "r9");
+#endif
+}
+__attribute__((always_inline)) inline void save_run_to_r17() {
+#if defined(__AVR__)
+    asm volatile("" ::: "r16", "r17");
+#endif
+}
+
 // (a b) >> 30: products of Q30 factors, and Q8 coordinates times Q30 factors.
 __attribute__((noinline)) int32_t mul_q30(int32_t a, int32_t b) {
     return mul_shift(a, b, 30);
@@ -103,6 +119,7 @@ const uint32_t kSeriesQ30[3][5] LL_PROGMEM = {
 
 // Series `which` of kSeriesQ30 at y (Horner's rule), Q30.
 int32_t series(uint8_t which, int32_t y) {
+    save_run_to_r17();
     int32_t r = 0;
     for (uint8_t i = 5; i-- > 0;) {
         r = static_cast<int32_t>(flash_read_u32(&kSeriesQ30[which][i])) + mul_q30(r, y);
@@ -112,6 +129,7 @@ int32_t series(uint8_t which, int32_t y) {
 
 // rot = (cos h, sin h) for |h| <= 0.4 rad, Q30.
 void rotation(int32_t h, int32_t rot[2]) {
+    save_run_to_r17();
     int32_t y = -mul_q30(h, h);
     rot[0] = series(0, y);
     rot[1] = mul_q30(h, series(1, y));
@@ -625,6 +643,7 @@ void tangent(Track& k, int32_t out[3]) {
 // widest panel there). On a Bezier, the radius of curvature |P'|^3 / |P' x P''| (x 2^scale) there
 // is kept in k.rmin when it is the smallest so far.
 Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
+    save_run_from_r8();
     int32_t d1[2], d2[2];
     track_at(k, off, move, d1, d2);
     Num n1 = norm(d1, k, false);
