@@ -610,7 +610,7 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
     // size is used).
     for (uint8_t i = 0; i < 2; ++i) {
         int32_t a = v[1 - i];
-        if ((i != 0) == k.clockwise) a = -a;
+        if (i == k.clockwise) a = -a;
         d1[i] = mul_q30(k.e.r[i], a);
         d2[i] = mul_q30(k.e.r[i], v[i]);
     }
