@@ -445,9 +445,10 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
         int32_t d[4];
         for (uint8_t i = 0; i < 4; ++i) d[i] = (pts_[k][i] = src[i][k]) >> 8;
         differences(d);
-        uint32_t b = 3 * (uabs(d[1]) + 2 * uabs(d[2]) + uabs(d[3]));
+        uint32_t b = uabs(d[1]) + 2 * uabs(d[2]) + uabs(d[3]);
         if (b > bound) bound = b;
     }
+    bound *= 3;
     // 2^j pieces, each with a hodograph bound below kMaxPieceTicks (it shrinks with 2^j).
     uint8_t j = 0;
     for (; bound >= kMaxPieceTicks; bound >>= 1) {
