@@ -216,9 +216,17 @@ inline void fd_step(int64_t v[4]) {
     uint8_t n, k, x, y;
     asm volatile("ldi  %[n], 3\n"
                  "1:\n\t"
-                 "ldi  %[k], 4\n\t"
+                 "ldi  %[k], 2\n\t"
                  "clc\n"
                  "2:\n\t"
+                 "ld   %[x], Z\n\t"
+                 "ldd  %[y], Z+8\n\t"
+                 "adc  %[x], %[y]\n\t"
+                 "st   Z+, %[x]\n\t"
+                 "ld   %[x], Z\n\t"
+                 "ldd  %[y], Z+8\n\t"
+                 "adc  %[x], %[y]\n\t"
+                 "st   Z+, %[x]\n\t"
                  "ld   %[x], Z\n\t"
                  "ldd  %[y], Z+8\n\t"
                  "adc  %[x], %[y]\n\t"
@@ -497,9 +505,12 @@ bool CurveWalker::next_piece() {
 }
 
 bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
-    moved = neg = 0;
+    save_run_from_r8();
     if (left_ == 0) { // (a piece has at least one sample)
-        if (kind_ == 0) return false;
+        if (kind_ == 0) {
+            moved = neg = 0;
+            return false;
+        }
         // Last step: from the rounded end of the curve to the exact target (at most one tick
         // per axis: both are within 0.71 tick of the curve's end point).
         if (!next_piece()) kind_ = 0;
