@@ -9,8 +9,8 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the walker reads the h
 
 // Size on the ATmega328P: every 64-bit addition, shift or product is a library call wrapped in
 // long register moves, and every Num operation a call sequence. So these operations are written
-// once, in the out-of-line helpers below (the sample step and the 64-bit sums of add_q40 in
-// assembly, the only 64-bit library routines left a signed product and a shift), the axes are
+// once, in the out-of-line helpers below (the sample step, the 64-bit sums of add_q40 and the
+// signed product of mul_shift in assembly: no 64-bit library routine is left), the axes are
 // loops, arrays are copied with memcpy (a byte loop, where four-byte moves are unrolled), and the
 // walker's small fields come first (a field within 63 bytes of the object is reached by
 // displacement).
@@ -25,56 +25,113 @@ constexpr uint32_t kTurnQ29 = 2ul * kPiQ29;
 // 0.02 tick.
 constexpr uint32_t kMaxPieceTicks = 2000;
 
-// floor(a b / 2^s) for s <= 32, the result within 32 bits.
-__attribute__((noinline)) int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
 #if defined(__AVR__)
-    // The unsigned product of fixmath's multiplier made signed (a negative factor as the unsigned
-    // one less 2^32), then the bits s to s + 31 of the 64-bit word, whole bytes by moves first:
-    // avr-gcc would call its 64-bit product routines, which nothing else in the image needs.
-    // (Bits shifted in at the top never reach the low word for s <= 32.)
-    uint32_t corr = 0;
-    if (a < 0) corr += static_cast<uint32_t>(b);
-    if (b < 0) corr += static_cast<uint32_t>(a);
-    register uint32_t hi asm("r22") = static_cast<uint32_t>(a);
-    register uint32_t lo asm("r18") = static_cast<uint32_t>(b);
-    asm("call __ll_mul32" // fixmath.cpp: the product in (hi, lo)
-        : "+r"(hi), "+r"(lo)
-        :
-        : "r14", "r15", "r16", "r17", "r26", "r27", "r30", "r31");
-    hi -= corr;
-    asm("1:\n\t"
-        "cpi  %[s], 8\n\t"
-        "brlo 2f\n\t"
-        "mov  %A[lo], %B[lo]\n\t"
-        "mov  %B[lo], %C[lo]\n\t"
-        "mov  %C[lo], %D[lo]\n\t"
-        "mov  %D[lo], %A[hi]\n\t"
-        "mov  %A[hi], %B[hi]\n\t"
-        "mov  %B[hi], %C[hi]\n\t"
-        "mov  %C[hi], %D[hi]\n\t"
-        "subi %[s], 8\n\t"
-        "rjmp 1b\n"
-        "2:\n\t"
-        "tst  %[s]\n\t"
-        "breq 4f\n"
-        "3:\n\t"
-        "lsr  %D[hi]\n\t"
-        "ror  %C[hi]\n\t"
-        "ror  %B[hi]\n\t"
-        "ror  %A[hi]\n\t"
-        "ror  %D[lo]\n\t"
-        "ror  %C[lo]\n\t"
-        "ror  %B[lo]\n\t"
-        "ror  %A[lo]\n\t"
-        "dec  %[s]\n\t"
-        "brne 3b\n"
-        "4:"
-        : [hi] "+r"(hi), [lo] "+r"(lo), [s] "+d"(s));
-    return static_cast<int32_t>(lo);
-#else
-    return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> s);
-#endif
+// floor(a b / 2^s) for s <= 32 (mul_q30: s = 30), the result within 32 bits. The unsigned product
+// of fixmath's multiplier (__ll_mul32, its own register convention) made signed (a negative
+// factor counts as the unsigned one less 2^32: the other factor is taken off the high word), then
+// the bits s to s + 31 of the 64-bit word, whole bytes by moves first; bits shifted in at the top
+// never reach the low word for s <= 32. In assembly: avr-gcc would call its 64-bit product and
+// shift routines, which nothing else in the image needs, and it saves more registers.
+extern "C" int32_t ll_curve_mul_shift(int32_t a, int32_t b, uint8_t s);
+extern "C" int32_t ll_curve_mul_q30(int32_t a, int32_t b);
+asm(".section .text.ll_curve_mul_shift,\"ax\",@progbits\n"
+    ".global ll_curve_mul_q30\n"
+    "ll_curve_mul_q30:\n"
+    "ldi  r26, 30\n"
+    "rjmp 1f\n"
+    ".global ll_curve_mul_shift\n"
+    "ll_curve_mul_shift:\n"
+    "mov  r26, r16\n"
+    "1:\n"
+    "push r14\n"
+    "push r15\n"
+    "push r16\n"
+    "push r17\n"
+    "push r26\n" // s
+    "clr  r26\n" // the correction: (a < 0 ? b : 0) + (b < 0 ? a : 0)
+    "clr  r27\n"
+    "movw r30, r26\n"
+    "sbrs r25, 7\n"
+    "rjmp 2f\n"
+    "movw r26, r18\n"
+    "movw r30, r20\n"
+    "2:\n"
+    "sbrs r21, 7\n"
+    "rjmp 3f\n"
+    "add  r26, r22\n"
+    "adc  r27, r23\n"
+    "adc  r30, r24\n"
+    "adc  r31, r25\n"
+    "3:\n"
+    "push r26\n"
+    "push r27\n"
+    "push r30\n"
+    "push r31\n"
+    "call __ll_mul32\n" // (r22..r25, r18..r21) = the product's (high, low) words
+    "pop  r31\n"
+    "pop  r30\n"
+    "pop  r27\n"
+    "pop  r26\n"
+    "sub  r22, r26\n"
+    "sbc  r23, r27\n"
+    "sbc  r24, r30\n"
+    "sbc  r25, r31\n"
+    "pop  r26\n"
+    "pop  r17\n"
+    "pop  r16\n"
+    "pop  r15\n"
+    "pop  r14\n"
+    "4:\n"
+    "cpi  r26, 8\n"
+    "brlo 5f\n"
+    "mov  r18, r19\n"
+    "mov  r19, r20\n"
+    "mov  r20, r21\n"
+    "mov  r21, r22\n"
+    "mov  r22, r23\n"
+    "mov  r23, r24\n"
+    "mov  r24, r25\n"
+    "subi r26, 8\n"
+    "rjmp 4b\n"
+    "5:\n"
+    "tst  r26\n"
+    "breq 7f\n"
+    "6:\n"
+    "lsr  r25\n"
+    "ror  r24\n"
+    "ror  r23\n"
+    "ror  r22\n"
+    "ror  r21\n"
+    "ror  r20\n"
+    "ror  r19\n"
+    "ror  r18\n"
+    "dec  r26\n"
+    "brne 6b\n"
+    "7:\n"
+    "movw r22, r18\n"
+    "movw r24, r20\n"
+    "ret\n"
+    ".text\n");
+
+inline int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
+    return ll_curve_mul_shift(a, b, s);
 }
+
+// (a b) >> 30: products of Q30 factors, and Q8 coordinates times Q30 factors.
+inline int32_t mul_q30(int32_t a, int32_t b) {
+    return ll_curve_mul_q30(a, b);
+}
+#else
+// floor(a b / 2^s), the result within 32 bits.
+__attribute__((noinline)) int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
+    return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> s);
+}
+
+// (a b) >> 30: products of Q30 factors, and Q8 coordinates times Q30 factors.
+__attribute__((noinline)) int32_t mul_q30(int32_t a, int32_t b) {
+    return mul_shift(a, b, 30);
+}
+#endif
 
 // avr-gcc's -mcall-prologues saves and restores registers through the shared
 // __prologue_saves__ / __epilogue_restores__ only when the saved ones form a single run ending at
@@ -90,11 +147,6 @@ __attribute__((always_inline)) inline void save_run_to_r17() {
 #if defined(__AVR__)
     asm volatile("" ::: "r16", "r17");
 #endif
-}
-
-// (a b) >> 30: products of Q30 factors, and Q8 coordinates times Q30 factors.
-__attribute__((noinline)) int32_t mul_q30(int32_t a, int32_t b) {
-    return mul_shift(a, b, 30);
 }
 
 // abs32 out of line: inline, each of its many uses costs 18 bytes on the AVR.
