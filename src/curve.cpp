@@ -38,11 +38,11 @@ asm(".section .text.ll_curve_mul_shift,\"ax\",@progbits\n"
     ".global ll_curve_mul_q30\n"
     "ll_curve_mul_q30:\n"
     "ldi  r26, 30\n"
-    "rjmp 1f\n"
+    "rjmp .Lll_curve_mul\n"
     ".global ll_curve_mul_shift\n"
     "ll_curve_mul_shift:\n"
     "mov  r26, r16\n"
-    "1:\n"
+    ".Lll_curve_mul:\n"
     "push r14\n"
     "push r15\n"
     "push r16\n"
@@ -111,7 +111,34 @@ asm(".section .text.ll_curve_mul_shift,\"ax\",@progbits\n"
     "movw r22, r18\n"
     "movw r24, r20\n"
     "ret\n"
+    // lerp(x, y, a) = x + mul_shift(y - x, a, 20): x in r22..r25, y in r18..r21, a in r14..r17.
+    ".global ll_curve_lerp\n"
+    "ll_curve_lerp:\n"
+    "push r22\n"
+    "push r23\n"
+    "push r24\n"
+    "push r25\n"
+    "sub  r18, r22\n"
+    "sbc  r19, r23\n"
+    "sbc  r20, r24\n"
+    "sbc  r21, r25\n"
+    "movw r22, r18\n"
+    "movw r24, r20\n"
+    "movw r18, r14\n"
+    "movw r20, r16\n"
+    "ldi  r26, 20\n"
+    "rcall .Lll_curve_mul\n"
+    "pop  r21\n"
+    "pop  r20\n"
+    "pop  r19\n"
+    "pop  r18\n"
+    "add  r22, r18\n"
+    "adc  r23, r19\n"
+    "adc  r24, r20\n"
+    "adc  r25, r21\n"
+    "ret\n"
     ".text\n");
+extern "C" int32_t ll_curve_lerp(int32_t x, int32_t y, uint32_t a_q20);
 
 inline int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
     return ll_curve_mul_shift(a, b, s);
@@ -357,9 +384,15 @@ __attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s, uint8
 
 // x + (y - x) a = (x (2^20 - a) + y a) / 2^20 (floored), a in [0, 1] as Q20: one step of de
 // Casteljau's algorithm, exact (y - x fits in 32 bits: the points are within 2^30 of zero).
+#if defined(__AVR__)
+inline int32_t lerp(int32_t x, int32_t y, uint32_t a_q20) {
+    return ll_curve_lerp(x, y, a_q20); // (in the assembly of mul_shift)
+}
+#else
 __attribute__((noinline)) int32_t lerp(int32_t x, int32_t y, uint32_t a_q20) {
     return x + mul_shift(y - x, static_cast<int32_t>(a_q20), 20);
 }
+#endif
 
 // x + 2 pi (radians x 2^29), out of line: in a loop, avr-gcc would make the sum of the turns a
 // 64-bit product, a library routine that nothing else in the image needs.
