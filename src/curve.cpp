@@ -430,41 +430,41 @@ void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
     left_ = 0;
 }
 
-void CurveWalker::start_piece(const Piece& g) {
+void CurveWalker::start_piece(Piece& g) {
     // The cubic from prev_q8_ (p0) to p3 whose control points are p0 + arm0 / 3 and
     // p3 - arm3 / 3, ticks x 256: relative to p0, c1 t + c2 t^2 + c3 t^3 with c1 = arm0,
-    // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0.
-    int32_t c[3][3];
+    // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0 (in place of arm0, p3 and arm3).
+    uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
+    for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
     for (uint8_t a = 0; a < 3; ++a) {
-        int32_t* k = c[a];
-        const int32_t d = g.p3[a] - prev_q8_[a];
-        k[0] = g.arm0[a];
-        k[2] = g.arm0[a] + g.arm3[a] - 2 * d;
-        k[1] = d - k[0] - k[2];
-        const uint32_t a2 = abs32(k[2]);
-        const uint32_t b = abs32(k[0]) + 2 * (abs32(k[1]) + a2) + a2;
+        // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
+        memcpy(reinterpret_cast<uint8_t*>(fd_[a]) + 4, &prev_q8_[a], 4);
+        const int32_t d = g.v[kP3][a] - prev_q8_[a];
+        prev_q8_[a] = g.v[kP3][a];
+        const int32_t c1 = g.v[kArm0][a];
+        const int32_t c3 = c1 + g.v[kArm3][a] - 2 * d;
+        const int32_t c2 = d - c1 - c3;
+        g.v[kP3][a] = c2;
+        g.v[kArm3][a] = c3;
+        const uint32_t a2 = abs32(c3);
+        const uint32_t b = abs32(c1) + 2 * (abs32(c2) + a2) + a2;
         if (b > bound) bound = b;
     }
     // N = 2^m > bound (ticks): at most one tick per sample and axis.
     uint8_t m = 0;
     for (uint32_t b = bound >> 8; b != 0; b >>= 1) ++m;
     left_ = static_cast<uint16_t>(1u << m);
-    uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
-    for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
     for (uint8_t a = 0; a < 3; ++a) {
         int64_t* v = fd_[a];
-        // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
-        memcpy(reinterpret_cast<uint8_t*>(v) + 4, &prev_q8_[a], 4);
         // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
         // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3, term by term (c_pw / N^pw into the differences 1 to pw).
         uint8_t sh = m;
         for (uint8_t pw = 1; pw <= 3; ++pw, sh = static_cast<uint8_t>(sh + m)) {
             for (uint8_t i = 1; i <= pw; ++i) {
-                add_q40(v[i], c[a][pw - 1], sh, i == 1 ? 1 : pw == 2 ? 2 : 6);
+                add_q40(v[i], g.v[pw - 1][a], sh, i == 1 ? 1 : pw == 2 ? 2 : 6);
             }
         }
-        prev_q8_[a] = g.p3[a];
     }
 }
 
@@ -561,7 +561,7 @@ bool CurveWalker::next_piece() {
     bool last = pieces_ == 0;
     // The end of the piece on the curve and 3 x its arms at both ends, ticks x 256.
     Piece g;
-    int32_t *p3 = g.p3, *arm0 = g.arm0, *arm3 = g.arm3;
+    int32_t *p3 = g.v[kP3], *arm0 = g.v[kArm0], *arm3 = g.v[kArm3];
     // Helix: w moves linearly (arms of a third of its move), the last piece landing exactly on
     // the end.
     int32_t w3 = dw_q8_;
