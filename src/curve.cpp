@@ -182,11 +182,45 @@ __attribute__((noinline)) uint32_t uabs(int32_t v) {
 }
 
 // Forward differences in place: (p0, p1, p2, p3) -> (p0, p1 - p0, p2 - 2 p1 + p0, p3 - 3 p2 + ...).
+#if defined(__AVR__)
+// In assembly: passes of 3, 2 and 1 subtractions q[j] -= q[j - 1] from j = 3 down, byte by byte
+// (avr-gcc unrolls the loops into 32-bit loads and stores).
+extern "C" void ll_curve_differences(int32_t q[4]);
+asm(".section .text.ll_curve_differences,\"ax\",@progbits\n"
+    ".global ll_curve_differences\n"
+    "ll_curve_differences:\n"
+    "ldi  r18, 3\n" // subtractions in this pass
+    "1:\n"
+    "movw r30, r24\n"
+    "adiw r30, 8\n" // Z = &q[j - 1], j = 3
+    "mov  r19, r18\n"
+    "2:\n"
+    "ldi  r20, 4\n"
+    "clc\n"
+    "3:\n"
+    "ld   r21, Z+\n"
+    "ldd  r22, Z+3\n"
+    "sbc  r22, r21\n"
+    "std  Z+3, r22\n"
+    "dec  r20\n"
+    "brne 3b\n"
+    "sbiw r30, 8\n" // j - 1
+    "dec  r19\n"
+    "brne 2b\n"
+    "dec  r18\n"
+    "brne 1b\n"
+    "ret\n"
+    ".text\n");
+inline void differences(int32_t q[4]) {
+    ll_curve_differences(q);
+}
+#else
 void differences(int32_t q[4]) {
     for (uint8_t i = 1; i < 4; ++i) {
         for (uint8_t j = 3; j >= i; --j) q[j] -= q[j - 1];
     }
 }
+#endif
 
 // Taylor coefficients (Q30) of cos x, sin x / x and tan x / x as polynomials in x^2, with the
 // signs of cos and sin taken by evaluating at -x^2. For |x| <= 0.4 rad the first term left out is
