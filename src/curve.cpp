@@ -362,59 +362,70 @@ inline void fd_step(int64_t v[4]) {
 #endif
 }
 
-// acc += n x / 2^s in Q40 for x in Q8 (n x below 2^31, s <= 36): exact for s <= 32, floored
-// beyond.
-__attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s, uint8_t n) {
+// acc += x / 2^s in Q40 for x in Q8 (s <= 36): exact for s <= 32, floored beyond.
 #if defined(__AVR__)
-    // The addend in two words shifted together, then added byte by byte: avr-gcc would call the
-    // 64-bit shift and sum routines of its library, which nothing else in the image needs.
-    uint32_t hi = static_cast<uint32_t>(x * n), lo = 0;
-    uint8_t* p = reinterpret_cast<uint8_t*>(&acc);
-    asm volatile("tst  %[s]\n\t"
-                 "breq 2f\n"
-                 "1:\n\t"
-                 "asr  %D[hi]\n\t"
-                 "ror  %C[hi]\n\t"
-                 "ror  %B[hi]\n\t"
-                 "ror  %A[hi]\n\t"
-                 "ror  %D[lo]\n\t"
-                 "ror  %C[lo]\n\t"
-                 "ror  %B[lo]\n\t"
-                 "ror  %A[lo]\n\t"
-                 "dec  %[s]\n\t"
-                 "brne 1b\n"
-                 "2:\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "add  __tmp_reg__, %A[lo]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %B[lo]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %C[lo]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %D[lo]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %A[hi]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %B[hi]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %C[hi]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %D[hi]\n\t"
-                 "st   Z, __tmp_reg__"
-                 : [hi] "+r"(hi), [lo] "+r"(lo), [s] "+r"(s), "+z"(p)
-                 :
-                 : "memory");
-#else
-    acc += (static_cast<int64_t>(x * n) << 32) >> s;
-#endif
+// In assembly: the addend in two words (x, 0) shifted together, then added byte by byte. avr-gcc
+// would call the 64-bit shift and sum routines of its library, which nothing else in the image
+// needs.
+extern "C" void ll_curve_add_q40(int64_t& acc, int32_t x, uint8_t s);
+asm(".section .text.ll_curve_add_q40,\"ax\",@progbits\n"
+    ".global ll_curve_add_q40\n"
+    "ll_curve_add_q40:\n"
+    "mov  r30, r18\n" // s
+    "movw r26, r24\n" // X = &acc
+    "movw r24, r22\n" // (r22..r25, r18..r21) = (x, 0)
+    "movw r22, r20\n"
+    "clr  r18\n"
+    "clr  r19\n"
+    "movw r20, r18\n"
+    "tst  r30\n"
+    "breq 2f\n"
+    "1:\n"
+    "asr  r25\n"
+    "ror  r24\n"
+    "ror  r23\n"
+    "ror  r22\n"
+    "ror  r21\n"
+    "ror  r20\n"
+    "ror  r19\n"
+    "ror  r18\n"
+    "dec  r30\n"
+    "brne 1b\n"
+    "2:\n"
+    "ld   r0, X\n"
+    "add  r0, r18\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r19\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r20\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r21\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r22\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r23\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r24\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r25\n"
+    "st   X, r0\n"
+    "ret\n"
+    ".text\n");
+inline void add_q40(int64_t& acc, int32_t x, uint8_t s) {
+    ll_curve_add_q40(acc, x, s);
 }
+#else
+__attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s) {
+    acc += (static_cast<int64_t>(x) << 32) >> s;
+}
+#endif
 
 // x + (y - x) a = (x (2^20 - a) + y a) / 2^20 (floored), a in [0, 1] as Q20: one step of de
 // Casteljau's algorithm, exact (y - x fits in 32 bits: the points are within 2^30 of zero).
@@ -496,7 +507,9 @@ void CurveWalker::start_piece(Piece& g) {
         uint8_t sh = m;
         for (uint8_t pw = 1; pw <= 3; ++pw, sh = static_cast<uint8_t>(sh + m)) {
             for (uint8_t i = 1; i <= pw; ++i) {
-                add_q40(v[i], g.v[pw - 1][a], sh, i == 1 ? 1 : pw == 2 ? 2 : 6);
+                // (n c below 2^31)
+                const uint8_t n = i == 1 ? 1 : pw == 2 ? 2 : 6;
+                add_q40(v[i], g.v[pw - 1][a] * n, sh);
             }
         }
     }
