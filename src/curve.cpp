@@ -715,7 +715,97 @@ struct Track {
     Num rmin; ///< Bezier: smallest radius of curvature met so far (at first 2^100: none)
 };
 
-// Shifts v[0..n-1] left or right so that the largest magnitude is in [2^27, 2^28); the shift.
+// Shifts v[0..n-1] (n >= 1) left or right so that the largest magnitude is in [2^27, 2^28); the
+// shift (0 when all are zero).
+#if defined(__AVR__)
+// In assembly: the union of the magnitudes shifted up to its top bit counts the shift from -4
+// (top bit 31), then each value is shifted in place.
+extern "C" int8_t ll_curve_normalise(int32_t* v, uint8_t n);
+asm(".section .text.ll_curve_normalise,\"ax\",@progbits\n"
+    ".global ll_curve_normalise\n"
+    "ll_curve_normalise:\n"
+    "movw r30, r24\n" // Z = v
+    "movw r26, r24\n" // X: v[i], then the end
+    "mov  r0, r22\n"
+    "clr  r18\n" // r18..r21: the union of |v[i]|
+    "clr  r19\n"
+    "movw r20, r18\n"
+    "1:\n"
+    "ld   r22, X+\n"
+    "ld   r23, X+\n"
+    "ld   r24, X+\n"
+    "ld   r25, X+\n"
+    "sbrs r25, 7\n"
+    "rjmp 2f\n"
+    "com  r25\n"
+    "com  r24\n"
+    "com  r23\n"
+    "neg  r22\n"
+    "sbci r23, 0xFF\n"
+    "sbci r24, 0xFF\n"
+    "sbci r25, 0xFF\n"
+    "2:\n"
+    "or   r18, r22\n"
+    "or   r19, r23\n"
+    "or   r20, r24\n"
+    "or   r21, r25\n"
+    "dec  r0\n"
+    "brne 1b\n"
+    "ldi  r24, 0\n"
+    "mov  r22, r18\n"
+    "or   r22, r19\n"
+    "or   r22, r20\n"
+    "or   r22, r21\n"
+    "breq 9f\n"
+    "ldi  r24, 0xFC\n" // -4
+    "3:\n"
+    "sbrc r21, 7\n"
+    "rjmp 4f\n"
+    "lsl  r18\n"
+    "rol  r19\n"
+    "rol  r20\n"
+    "rol  r21\n"
+    "inc  r24\n"
+    "rjmp 3b\n"
+    "4:\n"
+    "ld   r18, Z\n"
+    "ldd  r19, Z+1\n"
+    "ldd  r20, Z+2\n"
+    "ldd  r21, Z+3\n"
+    "mov  r22, r24\n"
+    "tst  r22\n"
+    "breq 7f\n"
+    "brmi 6f\n"
+    "5:\n"
+    "lsl  r18\n"
+    "rol  r19\n"
+    "rol  r20\n"
+    "rol  r21\n"
+    "dec  r22\n"
+    "brne 5b\n"
+    "rjmp 7f\n"
+    "6:\n"
+    "asr  r21\n"
+    "ror  r20\n"
+    "ror  r19\n"
+    "ror  r18\n"
+    "inc  r22\n"
+    "brne 6b\n"
+    "7:\n"
+    "st   Z+, r18\n"
+    "st   Z+, r19\n"
+    "st   Z+, r20\n"
+    "st   Z+, r21\n"
+    "cp   r30, r26\n"
+    "cpc  r31, r27\n"
+    "brne 4b\n"
+    "9:\n"
+    "ret\n"
+    ".text\n");
+inline int8_t normalise(int32_t* v, uint8_t n) {
+    return ll_curve_normalise(v, n);
+}
+#else
 int8_t normalise(int32_t* v, uint8_t n) {
     uint32_t big = 0;
     for (uint8_t i = 0; i < n; ++i) big |= uabs(v[i]); // the largest's top bit
@@ -727,6 +817,7 @@ int8_t normalise(int32_t* v, uint8_t n) {
     }
     return sh;
 }
+#endif
 
 // P' and P'' (x 2^scale) at `off` (Q29) past the current point; with `move`, that point becomes
 // the current one.
