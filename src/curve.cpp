@@ -309,9 +309,12 @@ __attribute__((noinline)) void direction(const int32_t p[2], const int32_t centr
 }
 
 // Directions (cos t, sin t) of an arc's start and end seen from its centre in the ellipse's
-// scale (Q30), and its sweep without the extra turns (radians x 2^29).
-uint32_t arc_directions(const int32_t start[2], const int32_t end[2], const int32_t centre[2],
-                        const uint32_t radii[2], bool clockwise, int32_t dir[2][2]) {
+// scale (Q30), and its sweep without the extra turns (radians x 2^29, never 0); 0 for a null
+// radius.
+__attribute__((noinline)) uint32_t arc_directions(const int32_t start[2], const int32_t end[2],
+                                                  const int32_t centre[2], const uint32_t radii[2],
+                                                  bool clockwise, int32_t dir[2][2]) {
+    if (radii[0] == 0 || radii[1] == 0) return 0;
     direction(start, centre, radii, dir[0]);
     direction(end, centre, radii, dir[1]);
     // The signed sweep's low word (its magnitude is below 2^32).
@@ -528,14 +531,13 @@ void CurveWalker::arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2])
 bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t radii_q8[2],
                       bool clockwise, uint8_t turns) {
     kind_ = 0;
-    if (radii_q8[0] == 0 || radii_q8[1] == 0) return false;
     memcpy(a_.centre, centre_q8, sizeof(a_.centre));
     memcpy(a_.radii, radii_q8, sizeof(a_.radii));
     // Directions of the start and end points (their projections on the curve), and the sweep
     // with the extra turns, radians x 2^20 (below 2^31 for 255 turns).
-    uint32_t mag =
-        (arc_directions(e.start_q8, e.end_q8, a_.centre, a_.radii, clockwise, a_.dir) >> 9) +
-        turns * (kTurnQ29 >> 9);
+    uint32_t mag = arc_directions(e.start_q8, e.end_q8, a_.centre, a_.radii, clockwise, a_.dir);
+    if (mag == 0) return false; // a null radius
+    mag = (mag >> 9) + turns * (kTurnQ29 >> 9);
     // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees) and kMaxPieceTicks long (sweep x
     // radius ticks).
     uint32_t rmax = (a_.radii[0] > a_.radii[1] ? a_.radii[0] : a_.radii[1]) >> 8;
@@ -940,10 +942,10 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     k.rise = ld[1].set(uabs(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
-        if (r[0] == 0 || r[1] == 0) return false;
         k.clockwise = cp.clockwise != 0;
         // The sweep in (0, 2 pi], and with the extra full turns, radians.
         span = arc_directions(cp.start_um, cp.end_um, cp.a_um, r, k.clockwise, k.e.dir);
+        if (span == 0) return false; // a null radius
         widest = kWidestArcQ29;
         turns = cp.turns;
         len.set(kTurnQ29, -29).mul(turns).add(Num(span, -29));
