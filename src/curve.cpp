@@ -963,10 +963,8 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
         // these fit. w rises by dw per unit of t.
-        const int32_t* p[4] = {cp.start_um, cp.a_um, cp.b_um, cp.end_um};
         for (uint8_t i = 0; i < 2; ++i) {
-            int32_t q[4];
-            for (uint8_t j = 0; j < 4; ++j) q[j] = p[j][i];
+            int32_t q[4] = {cp.start_um[i], cp.a_um[i], cp.b_um[i], cp.end_um[i]};
             differences(q);
             for (uint8_t j = 0; j < 3; ++j) k.b.h[j][i] = (j == 1 ? 6 : 3) * q[j + 1];
         }
