@@ -593,12 +593,14 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
     bound *= 3;
     // 2^j pieces, each with a hodograph bound below kMaxPieceTicks (it shrinks with 2^j).
     uint8_t j = 0;
+    uint16_t n = 1;
     for (; bound >= kMaxPieceTicks; bound >>= 1) {
         if (j == 15) return false;
         ++j;
+        n = static_cast<uint16_t>(n << 1);
     }
     log_pieces_ = j;
-    piece_count_ = pieces_ = static_cast<uint16_t>(1u << j);
+    piece_count_ = pieces_ = n;
     begin(e, e.start_q8, 2);
     return true;
 }
