@@ -501,8 +501,12 @@ void CurveWalker::start_piece(Piece& g) {
     }
     // N = 2^m > bound (ticks): at most one tick per sample and axis.
     uint8_t m = 0;
-    for (uint32_t b = bound >> 8; b != 0; b >>= 1) ++m;
-    left_ = static_cast<uint16_t>(1u << m);
+    uint16_t samples = 1;
+    for (uint32_t b = bound >> 8; b != 0; b >>= 1) {
+        ++m;
+        samples = static_cast<uint16_t>(samples << 1);
+    }
+    left_ = samples;
     for (uint8_t a = 0; a < 3; ++a) {
         int64_t* v = fd_[a];
         // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
