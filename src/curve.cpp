@@ -270,10 +270,10 @@ __attribute__((noinline)) Num root_sum_squares(const Num* q, uint8_t n) {
 __attribute__((noinline)) void unit_vector(const Num* q, uint8_t n, uint8_t neg, uint8_t bits,
                                            int32_t* out) {
     const Num norm = root_sum_squares(q, n);
-    for (uint8_t i = 0; i < n; ++i) {
+    for (uint8_t i = 0, bit = 1; i < n; ++i, bit = static_cast<uint8_t>(bit << 1)) {
         uint32_t u = Num(q[i]).div(norm).shift(static_cast<int8_t>(bits)).u32();
         if (u > (1ul << bits)) u = 1ul << bits;
-        out[i] = (neg >> i) & 1 ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+        out[i] = neg & bit ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
 }
 
