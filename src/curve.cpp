@@ -295,7 +295,9 @@ __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& thir
     q[2] = third;
     q[1].set(uabs(v[1]));
     q[0].set(uabs(v[0]));
-    return static_cast<uint8_t>((v[0] < 0) | (v[1] < 0) << 1);
+    uint8_t neg = v[1] < 0 ? 2 : 0;
+    if (v[0] < 0) ++neg;
+    return neg;
 }
 
 // ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30.
