@@ -266,12 +266,12 @@ __attribute__((noinline)) Num root_sum_squares(const Num* q, uint8_t n) {
 }
 
 // out[i] = q[i] / |q| for the n components of q, `bits` fraction bits, negated where bit i of
-// `neg` is set; 0 for q = 0 (a quotient by zero is zero).
-__attribute__((noinline)) void unit_vector(const Num* q, uint8_t n, uint8_t neg, uint8_t bits,
+// `neg` is set; 0 for q = 0 (a quotient by zero is zero). The q are overwritten.
+__attribute__((noinline)) void unit_vector(Num* q, uint8_t n, uint8_t neg, uint8_t bits,
                                            int32_t* out) {
     const Num norm = root_sum_squares(q, n);
     for (uint8_t i = 0, bit = 1; i < n; ++i, bit = static_cast<uint8_t>(bit << 1)) {
-        uint32_t u = Num(q[i]).div(norm).shift(static_cast<int8_t>(bits)).u32();
+        uint32_t u = q[i].div(norm).shift(static_cast<int8_t>(bits)).u32(); // (q is spent)
         if (u > (1ul << bits)) u = 1ul << bits;
         out[i] = neg & bit ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
