@@ -865,7 +865,7 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
 __attribute__((noinline)) Num norm(const int32_t v[2], const Track& k, bool with_rise) {
     Num q[3];
     components(v, k.rise, q);
-    return root_sum_squares(q, with_rise ? 3 : 2);
+    return root_sum_squares(q, static_cast<uint8_t>(2 + with_rise));
 }
 
 // The unit tangent (P', w') / |(P', w')| at the current point, Q29. Where P' = 0 (a Bezier whose
