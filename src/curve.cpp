@@ -847,7 +847,8 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
     memcpy(v, k.e.dir[0], sizeof(v));
     if (off) {
         int32_t rot[2], h = static_cast<int32_t>(off << 1);
-        rotation(k.clockwise ? -h : h, rot);
+        if (k.clockwise) h = -h;
+        rotation(h, rot);
         rotate(v, rot);
     }
     if (move) memcpy(k.e.dir[0], v, sizeof(v));
