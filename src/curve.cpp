@@ -9,8 +9,8 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the walker reads the h
 
 // Size on the ATmega328P: every 64-bit addition, shift or product is a library call wrapped in
 // long register moves, and every Num operation a call sequence. So these operations are written
-// once, in the out-of-line helpers below (the sample step and the 64-bit sums of add_q40 in
-// assembly, the only 64-bit library routines left a signed product and a shift), the axes are
+// once, in the out-of-line helpers below (the sample step, the 64-bit sums of add_q40 and the
+// signed product of mul_shift in assembly: no 64-bit library routine is left), the axes are
 // loops, arrays are copied with memcpy (a byte loop, where four-byte moves are unrolled), and the
 // walker's small fields come first (a field within 63 bytes of the object is reached by
 // displacement).
@@ -25,6 +25,130 @@ constexpr uint32_t kTurnQ29 = 2ul * kPiQ29;
 // 0.02 tick.
 constexpr uint32_t kMaxPieceTicks = 2000;
 
+#if defined(__AVR__)
+// floor(a b / 2^s) for s <= 32 (mul_q30: s = 30), the result within 32 bits. The unsigned product
+// of fixmath's multiplier (__ll_mul32, its own register convention) made signed (a negative
+// factor counts as the unsigned one less 2^32: the other factor is taken off the high word), then
+// the bits s to s + 31 of the 64-bit word, whole bytes by moves first; bits shifted in at the top
+// never reach the low word for s <= 32. In assembly: avr-gcc would call its 64-bit product and
+// shift routines, which nothing else in the image needs, and it saves more registers.
+extern "C" int32_t ll_curve_mul_shift(int32_t a, int32_t b, uint8_t s);
+extern "C" int32_t ll_curve_mul_q30(int32_t a, int32_t b);
+asm(".section .text.ll_curve_mul_shift,\"ax\",@progbits\n"
+    ".global ll_curve_mul_q30\n"
+    "ll_curve_mul_q30:\n"
+    "ldi  r26, 30\n"
+    "rjmp .Lll_curve_mul\n"
+    ".global ll_curve_mul_shift\n"
+    "ll_curve_mul_shift:\n"
+    "mov  r26, r16\n"
+    ".Lll_curve_mul:\n"
+    "push r14\n"
+    "push r15\n"
+    "push r16\n"
+    "push r17\n"
+    "push r26\n" // s
+    "clr  r26\n" // the correction: (a < 0 ? b : 0) + (b < 0 ? a : 0)
+    "clr  r27\n"
+    "movw r30, r26\n"
+    "sbrs r25, 7\n"
+    "rjmp 2f\n"
+    "movw r26, r18\n"
+    "movw r30, r20\n"
+    "2:\n"
+    "sbrs r21, 7\n"
+    "rjmp 3f\n"
+    "add  r26, r22\n"
+    "adc  r27, r23\n"
+    "adc  r30, r24\n"
+    "adc  r31, r25\n"
+    "3:\n"
+    "push r26\n"
+    "push r27\n"
+    "push r30\n"
+    "push r31\n"
+    "call __ll_mul32\n" // (r22..r25, r18..r21) = the product's (high, low) words
+    "pop  r31\n"
+    "pop  r30\n"
+    "pop  r27\n"
+    "pop  r26\n"
+    "sub  r22, r26\n"
+    "sbc  r23, r27\n"
+    "sbc  r24, r30\n"
+    "sbc  r25, r31\n"
+    "pop  r26\n"
+    "pop  r17\n"
+    "pop  r16\n"
+    "pop  r15\n"
+    "pop  r14\n"
+    "4:\n"
+    "cpi  r26, 8\n"
+    "brlo 5f\n"
+    "mov  r18, r19\n"
+    "mov  r19, r20\n"
+    "mov  r20, r21\n"
+    "mov  r21, r22\n"
+    "mov  r22, r23\n"
+    "mov  r23, r24\n"
+    "mov  r24, r25\n"
+    "subi r26, 8\n"
+    "rjmp 4b\n"
+    "5:\n"
+    "tst  r26\n"
+    "breq 7f\n"
+    "6:\n"
+    "lsr  r25\n"
+    "ror  r24\n"
+    "ror  r23\n"
+    "ror  r22\n"
+    "ror  r21\n"
+    "ror  r20\n"
+    "ror  r19\n"
+    "ror  r18\n"
+    "dec  r26\n"
+    "brne 6b\n"
+    "7:\n"
+    "movw r22, r18\n"
+    "movw r24, r20\n"
+    "ret\n"
+    // lerp(x, y, a) = x + mul_shift(y - x, a, 20): x in r22..r25, y in r18..r21, a in r14..r17.
+    ".global ll_curve_lerp\n"
+    "ll_curve_lerp:\n"
+    "push r22\n"
+    "push r23\n"
+    "push r24\n"
+    "push r25\n"
+    "sub  r18, r22\n"
+    "sbc  r19, r23\n"
+    "sbc  r20, r24\n"
+    "sbc  r21, r25\n"
+    "movw r22, r18\n"
+    "movw r24, r20\n"
+    "movw r18, r14\n"
+    "movw r20, r16\n"
+    "ldi  r26, 20\n"
+    "rcall .Lll_curve_mul\n"
+    "pop  r21\n"
+    "pop  r20\n"
+    "pop  r19\n"
+    "pop  r18\n"
+    "add  r22, r18\n"
+    "adc  r23, r19\n"
+    "adc  r24, r20\n"
+    "adc  r25, r21\n"
+    "ret\n"
+    ".text\n");
+extern "C" int32_t ll_curve_lerp(int32_t x, int32_t y, uint32_t a_q20);
+
+inline int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
+    return ll_curve_mul_shift(a, b, s);
+}
+
+// (a b) >> 30: products of Q30 factors, and Q8 coordinates times Q30 factors.
+inline int32_t mul_q30(int32_t a, int32_t b) {
+    return ll_curve_mul_q30(a, b);
+}
+#else
 // floor(a b / 2^s), the result within 32 bits.
 __attribute__((noinline)) int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
     return static_cast<int32_t>((static_cast<int64_t>(a) * b) >> s);
@@ -34,6 +158,23 @@ __attribute__((noinline)) int32_t mul_shift(int32_t a, int32_t b, uint8_t s) {
 __attribute__((noinline)) int32_t mul_q30(int32_t a, int32_t b) {
     return mul_shift(a, b, 30);
 }
+#endif
+
+// avr-gcc's -mcall-prologues saves and restores registers through the shared
+// __prologue_saves__ / __epilogue_restores__ only when the saved ones form a single run ending at
+// r17; otherwise each function pushes and pops them one by one (and sets up its frame in line).
+// These empty statements mark the gap of a function's run as used: a few bytes of stack for
+// 40 to 80 bytes of code.
+__attribute__((always_inline)) inline void save_run_from_r8() {
+#if defined(__AVR__)
+    asm volatile("" ::: "r8", "r9");
+#endif
+}
+__attribute__((always_inline)) inline void save_run_to_r17() {
+#if defined(__AVR__)
+    asm volatile("" ::: "r16", "r17");
+#endif
+}
 
 // abs32 out of line: inline, each of its many uses costs 18 bytes on the AVR.
 __attribute__((noinline)) uint32_t uabs(int32_t v) {
@@ -41,11 +182,45 @@ __attribute__((noinline)) uint32_t uabs(int32_t v) {
 }
 
 // Forward differences in place: (p0, p1, p2, p3) -> (p0, p1 - p0, p2 - 2 p1 + p0, p3 - 3 p2 + ...).
+#if defined(__AVR__)
+// In assembly: passes of 3, 2 and 1 subtractions q[j] -= q[j - 1] from j = 3 down, byte by byte
+// (avr-gcc unrolls the loops into 32-bit loads and stores).
+extern "C" void ll_curve_differences(int32_t q[4]);
+asm(".section .text.ll_curve_differences,\"ax\",@progbits\n"
+    ".global ll_curve_differences\n"
+    "ll_curve_differences:\n"
+    "ldi  r18, 3\n" // subtractions in this pass
+    "1:\n"
+    "movw r30, r24\n"
+    "adiw r30, 8\n" // Z = &q[j - 1], j = 3
+    "mov  r19, r18\n"
+    "2:\n"
+    "ldi  r20, 4\n"
+    "clc\n"
+    "3:\n"
+    "ld   r21, Z+\n"
+    "ldd  r22, Z+3\n"
+    "sbc  r22, r21\n"
+    "std  Z+3, r22\n"
+    "dec  r20\n"
+    "brne 3b\n"
+    "sbiw r30, 8\n" // j - 1
+    "dec  r19\n"
+    "brne 2b\n"
+    "dec  r18\n"
+    "brne 1b\n"
+    "ret\n"
+    ".text\n");
+inline void differences(int32_t q[4]) {
+    ll_curve_differences(q);
+}
+#else
 void differences(int32_t q[4]) {
     for (uint8_t i = 1; i < 4; ++i) {
         for (uint8_t j = 3; j >= i; --j) q[j] -= q[j - 1];
     }
 }
+#endif
 
 // Taylor coefficients (Q30) of cos x, sin x / x and tan x / x as polynomials in x^2, with the
 // signs of cos and sin taken by evaluating at -x^2. For |x| <= 0.4 rad the first term left out is
@@ -57,6 +232,7 @@ const uint32_t kSeriesQ30[3][5] LL_PROGMEM = {
 
 // Series `which` of kSeriesQ30 at y (Horner's rule), Q30.
 int32_t series(uint8_t which, int32_t y) {
+    save_run_to_r17();
     int32_t r = 0;
     for (uint8_t i = 5; i-- > 0;) {
         r = static_cast<int32_t>(flash_read_u32(&kSeriesQ30[which][i])) + mul_q30(r, y);
@@ -66,6 +242,7 @@ int32_t series(uint8_t which, int32_t y) {
 
 // rot = (cos h, sin h) for |h| <= 0.4 rad, Q30.
 void rotation(int32_t h, int32_t rot[2]) {
+    save_run_to_r17();
     int32_t y = -mul_q30(h, h);
     rot[0] = series(0, y);
     rot[1] = mul_q30(h, series(1, y));
@@ -89,14 +266,14 @@ __attribute__((noinline)) Num root_sum_squares(const Num* q, uint8_t n) {
 }
 
 // out[i] = q[i] / |q| for the n components of q, `bits` fraction bits, negated where bit i of
-// `neg` is set; 0 for q = 0 (a quotient by zero is zero).
-__attribute__((noinline)) void unit_vector(const Num* q, uint8_t n, uint8_t neg, uint8_t bits,
+// `neg` is set; 0 for q = 0 (a quotient by zero is zero). The q are overwritten.
+__attribute__((noinline)) void unit_vector(Num* q, uint8_t n, uint8_t neg, uint8_t bits,
                                            int32_t* out) {
     const Num norm = root_sum_squares(q, n);
-    for (uint8_t i = 0; i < n; ++i) {
-        uint32_t u = Num(q[i]).div(norm).shift(static_cast<int8_t>(bits)).u32();
+    for (uint8_t i = 0, bit = 1; i < n; ++i, bit = static_cast<uint8_t>(bit << 1)) {
+        uint32_t u = q[i].div(norm).shift(static_cast<int8_t>(bits)).u32(); // (q is spent)
         if (u > (1ul << bits)) u = 1ul << bits;
-        out[i] = (neg >> i) & 1 ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+        out[i] = neg & bit ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
 }
 
@@ -118,7 +295,9 @@ __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& thir
     q[2] = third;
     q[1].set(uabs(v[1]));
     q[0].set(uabs(v[0]));
-    return static_cast<uint8_t>((v[0] < 0) | (v[1] < 0) << 1);
+    uint8_t neg = v[1] < 0 ? 2 : 0;
+    if (v[0] < 0) ++neg;
+    return neg;
 }
 
 // ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30.
@@ -132,9 +311,12 @@ __attribute__((noinline)) void direction(const int32_t p[2], const int32_t centr
 }
 
 // Directions (cos t, sin t) of an arc's start and end seen from its centre in the ellipse's
-// scale (Q30), and its sweep without the extra turns (radians x 2^29).
-uint32_t arc_directions(const int32_t start[2], const int32_t end[2], const int32_t centre[2],
-                        const uint32_t radii[2], bool clockwise, int32_t dir[2][2]) {
+// scale (Q30), and its sweep without the extra turns (radians x 2^29, never 0); 0 for a null
+// radius.
+__attribute__((noinline)) uint32_t arc_directions(const int32_t start[2], const int32_t end[2],
+                                                  const int32_t centre[2], const uint32_t radii[2],
+                                                  bool clockwise, int32_t dir[2][2]) {
+    if (radii[0] == 0 || radii[1] == 0) return 0;
     direction(start, centre, radii, dir[0]);
     direction(end, centre, radii, dir[1]);
     // The signed sweep's low word (its magnitude is below 2^32).
@@ -152,9 +334,17 @@ inline void fd_step(int64_t v[4]) {
     uint8_t n, k, x, y;
     asm volatile("ldi  %[n], 3\n"
                  "1:\n\t"
-                 "ldi  %[k], 4\n\t"
+                 "ldi  %[k], 2\n\t"
                  "clc\n"
                  "2:\n\t"
+                 "ld   %[x], Z\n\t"
+                 "ldd  %[y], Z+8\n\t"
+                 "adc  %[x], %[y]\n\t"
+                 "st   Z+, %[x]\n\t"
+                 "ld   %[x], Z\n\t"
+                 "ldd  %[y], Z+8\n\t"
+                 "adc  %[x], %[y]\n\t"
+                 "st   Z+, %[x]\n\t"
                  "ld   %[x], Z\n\t"
                  "ldd  %[y], Z+8\n\t"
                  "adc  %[x], %[y]\n\t"
@@ -177,65 +367,82 @@ inline void fd_step(int64_t v[4]) {
 #endif
 }
 
-// acc += n x / 2^s in Q40 for x in Q8 (n x below 2^31, s <= 36): exact for s <= 32, floored
-// beyond.
-__attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s, uint8_t n) {
+// acc += x / 2^s in Q40 for x in Q8 (s <= 36): exact for s <= 32, floored beyond.
 #if defined(__AVR__)
-    // The addend in two words shifted together, then added byte by byte: avr-gcc would call the
-    // 64-bit shift and sum routines of its library, which nothing else in the image needs.
-    uint32_t hi = static_cast<uint32_t>(x * n), lo = 0;
-    uint8_t* p = reinterpret_cast<uint8_t*>(&acc);
-    asm volatile("tst  %[s]\n\t"
-                 "breq 2f\n"
-                 "1:\n\t"
-                 "asr  %D[hi]\n\t"
-                 "ror  %C[hi]\n\t"
-                 "ror  %B[hi]\n\t"
-                 "ror  %A[hi]\n\t"
-                 "ror  %D[lo]\n\t"
-                 "ror  %C[lo]\n\t"
-                 "ror  %B[lo]\n\t"
-                 "ror  %A[lo]\n\t"
-                 "dec  %[s]\n\t"
-                 "brne 1b\n"
-                 "2:\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "add  __tmp_reg__, %A[lo]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %B[lo]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %C[lo]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %D[lo]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %A[hi]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %B[hi]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %C[hi]\n\t"
-                 "st   Z+, __tmp_reg__\n\t"
-                 "ld   __tmp_reg__, Z\n\t"
-                 "adc  __tmp_reg__, %D[hi]\n\t"
-                 "st   Z, __tmp_reg__"
-                 : [hi] "+r"(hi), [lo] "+r"(lo), [s] "+r"(s), "+z"(p)
-                 :
-                 : "memory");
-#else
-    acc += (static_cast<int64_t>(x * n) << 32) >> s;
-#endif
+// In assembly: the addend in two words (x, 0) shifted together, then added byte by byte. avr-gcc
+// would call the 64-bit shift and sum routines of its library, which nothing else in the image
+// needs.
+extern "C" void ll_curve_add_q40(int64_t& acc, int32_t x, uint8_t s);
+asm(".section .text.ll_curve_add_q40,\"ax\",@progbits\n"
+    ".global ll_curve_add_q40\n"
+    "ll_curve_add_q40:\n"
+    "mov  r30, r18\n" // s
+    "movw r26, r24\n" // X = &acc
+    "movw r24, r22\n" // (r22..r25, r18..r21) = (x, 0)
+    "movw r22, r20\n"
+    "clr  r18\n"
+    "clr  r19\n"
+    "movw r20, r18\n"
+    "tst  r30\n"
+    "breq 2f\n"
+    "1:\n"
+    "asr  r25\n"
+    "ror  r24\n"
+    "ror  r23\n"
+    "ror  r22\n"
+    "ror  r21\n"
+    "ror  r20\n"
+    "ror  r19\n"
+    "ror  r18\n"
+    "dec  r30\n"
+    "brne 1b\n"
+    "2:\n"
+    "ld   r0, X\n"
+    "add  r0, r18\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r19\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r20\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r21\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r22\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r23\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r24\n"
+    "st   X+, r0\n"
+    "ld   r0, X\n"
+    "adc  r0, r25\n"
+    "st   X, r0\n"
+    "ret\n"
+    ".text\n");
+inline void add_q40(int64_t& acc, int32_t x, uint8_t s) {
+    ll_curve_add_q40(acc, x, s);
 }
+#else
+__attribute__((noinline)) void add_q40(int64_t& acc, int32_t x, uint8_t s) {
+    acc += (static_cast<int64_t>(x) << 32) >> s;
+}
+#endif
 
 // x + (y - x) a = (x (2^20 - a) + y a) / 2^20 (floored), a in [0, 1] as Q20: one step of de
 // Casteljau's algorithm, exact (y - x fits in 32 bits: the points are within 2^30 of zero).
+#if defined(__AVR__)
+inline int32_t lerp(int32_t x, int32_t y, uint32_t a_q20) {
+    return ll_curve_lerp(x, y, a_q20); // (in the assembly of mul_shift)
+}
+#else
 __attribute__((noinline)) int32_t lerp(int32_t x, int32_t y, uint32_t a_q20) {
     return x + mul_shift(y - x, static_cast<int32_t>(a_q20), 20);
 }
+#endif
 
 // x + 2 pi (radians x 2^29), out of line: in a loop, avr-gcc would make the sum of the turns a
 // 64-bit product, a library routine that nothing else in the image needs.
@@ -273,41 +480,47 @@ void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
     left_ = 0;
 }
 
-void CurveWalker::start_piece(const Piece& g) {
+void CurveWalker::start_piece(Piece& g) {
     // The cubic from prev_q8_ (p0) to p3 whose control points are p0 + arm0 / 3 and
     // p3 - arm3 / 3, ticks x 256: relative to p0, c1 t + c2 t^2 + c3 t^3 with c1 = arm0,
-    // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0.
-    int32_t c[3][3];
+    // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0 (in place of arm0, p3 and arm3).
+    uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
+    for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
     for (uint8_t a = 0; a < 3; ++a) {
-        int32_t* k = c[a];
-        const int32_t d = g.p3[a] - prev_q8_[a];
-        k[0] = g.arm0[a];
-        k[2] = g.arm0[a] + g.arm3[a] - 2 * d;
-        k[1] = d - k[0] - k[2];
-        const uint32_t a2 = abs32(k[2]);
-        const uint32_t b = abs32(k[0]) + 2 * (abs32(k[1]) + a2) + a2;
+        // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
+        memcpy(reinterpret_cast<uint8_t*>(fd_[a]) + 4, &prev_q8_[a], 4);
+        const int32_t d = g.v[kP3][a] - prev_q8_[a];
+        prev_q8_[a] = g.v[kP3][a];
+        const int32_t c1 = g.v[kArm0][a];
+        const int32_t c3 = c1 + g.v[kArm3][a] - 2 * d;
+        const int32_t c2 = d - c1 - c3;
+        g.v[kP3][a] = c2;
+        g.v[kArm3][a] = c3;
+        const uint32_t a2 = abs32(c3);
+        const uint32_t b = abs32(c1) + 2 * (abs32(c2) + a2) + a2;
         if (b > bound) bound = b;
     }
     // N = 2^m > bound (ticks): at most one tick per sample and axis.
     uint8_t m = 0;
-    for (uint32_t b = bound >> 8; b != 0; b >>= 1) ++m;
-    left_ = static_cast<uint16_t>(1u << m);
-    uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
-    for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
+    uint16_t samples = 1;
+    for (uint32_t b = bound >> 8; b != 0; b >>= 1) {
+        ++m;
+        samples = static_cast<uint16_t>(samples << 1);
+    }
+    left_ = samples;
     for (uint8_t a = 0; a < 3; ++a) {
         int64_t* v = fd_[a];
-        // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
-        memcpy(reinterpret_cast<uint8_t*>(v) + 4, &prev_q8_[a], 4);
         // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
         // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3, term by term (c_pw / N^pw into the differences 1 to pw).
         uint8_t sh = m;
         for (uint8_t pw = 1; pw <= 3; ++pw, sh = static_cast<uint8_t>(sh + m)) {
             for (uint8_t i = 1; i <= pw; ++i) {
-                add_q40(v[i], c[a][pw - 1], sh, i == 1 ? 1 : pw == 2 ? 2 : 6);
+                // (n c below 2^31)
+                const uint8_t n = i == 1 ? 1 : pw == 2 ? 2 : 6;
+                add_q40(v[i], g.v[pw - 1][a] * n, sh);
             }
         }
-        prev_q8_[a] = g.p3[a];
     }
 }
 
@@ -324,14 +537,13 @@ void CurveWalker::arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2])
 bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t radii_q8[2],
                       bool clockwise, uint8_t turns) {
     kind_ = 0;
-    if (radii_q8[0] == 0 || radii_q8[1] == 0) return false;
     memcpy(a_.centre, centre_q8, sizeof(a_.centre));
     memcpy(a_.radii, radii_q8, sizeof(a_.radii));
     // Directions of the start and end points (their projections on the curve), and the sweep
     // with the extra turns, radians x 2^20 (below 2^31 for 255 turns).
-    uint32_t mag =
-        (arc_directions(e.start_q8, e.end_q8, a_.centre, a_.radii, clockwise, a_.dir) >> 9) +
-        turns * (kTurnQ29 >> 9);
+    uint32_t mag = arc_directions(e.start_q8, e.end_q8, a_.centre, a_.radii, clockwise, a_.dir);
+    if (mag == 0) return false; // a null radius
+    mag = (mag >> 9) + turns * (kTurnQ29 >> 9);
     // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees) and kMaxPieceTicks long (sweep x
     // radius ticks).
     uint32_t rmax = (a_.radii[0] > a_.radii[1] ? a_.radii[0] : a_.radii[1]) >> 8;
@@ -381,17 +593,20 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
         int32_t d[4];
         for (uint8_t i = 0; i < 4; ++i) d[i] = (pts_[k][i] = src[i][k]) >> 8;
         differences(d);
-        uint32_t b = 3 * (uabs(d[1]) + 2 * uabs(d[2]) + uabs(d[3]));
+        uint32_t b = uabs(d[1]) + 2 * uabs(d[2]) + uabs(d[3]);
         if (b > bound) bound = b;
     }
+    bound *= 3;
     // 2^j pieces, each with a hodograph bound below kMaxPieceTicks (it shrinks with 2^j).
     uint8_t j = 0;
+    uint16_t n = 1;
     for (; bound >= kMaxPieceTicks; bound >>= 1) {
         if (j == 15) return false;
         ++j;
+        n = static_cast<uint16_t>(n << 1);
     }
     log_pieces_ = j;
-    piece_count_ = pieces_ = static_cast<uint16_t>(1u << j);
+    piece_count_ = pieces_ = n;
     begin(e, e.start_q8, 2);
     return true;
 }
@@ -403,7 +618,7 @@ bool CurveWalker::next_piece() {
     bool last = pieces_ == 0;
     // The end of the piece on the curve and 3 x its arms at both ends, ticks x 256.
     Piece g;
-    int32_t *p3 = g.p3, *arm0 = g.arm0, *arm3 = g.arm3;
+    int32_t *p3 = g.v[kP3], *arm0 = g.v[kArm0], *arm3 = g.v[kArm3];
     // Helix: w moves linearly (arms of a third of its move), the last piece landing exactly on
     // the end.
     int32_t w3 = dw_q8_;
@@ -432,9 +647,12 @@ bool CurveWalker::next_piece() {
 }
 
 bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
-    moved = neg = 0;
+    save_run_from_r8();
     if (left_ == 0) { // (a piece has at least one sample)
-        if (kind_ == 0) return false;
+        if (kind_ == 0) {
+            moved = neg = 0;
+            return false;
+        }
         // Last step: from the rounded end of the curve to the exact target (at most one tick
         // per axis: both are within 0.71 tick of the curve's end point).
         if (!next_piece()) kind_ = 0;
@@ -507,7 +725,97 @@ struct Track {
     Num rmin; ///< Bezier: smallest radius of curvature met so far (at first 2^100: none)
 };
 
-// Shifts v[0..n-1] left or right so that the largest magnitude is in [2^27, 2^28); the shift.
+// Shifts v[0..n-1] (n >= 1) left or right so that the largest magnitude is in [2^27, 2^28); the
+// shift (0 when all are zero).
+#if defined(__AVR__)
+// In assembly: the union of the magnitudes shifted up to its top bit counts the shift from -4
+// (top bit 31), then each value is shifted in place.
+extern "C" int8_t ll_curve_normalise(int32_t* v, uint8_t n);
+asm(".section .text.ll_curve_normalise,\"ax\",@progbits\n"
+    ".global ll_curve_normalise\n"
+    "ll_curve_normalise:\n"
+    "movw r30, r24\n" // Z = v
+    "movw r26, r24\n" // X: v[i], then the end
+    "mov  r0, r22\n"
+    "clr  r18\n" // r18..r21: the union of |v[i]|
+    "clr  r19\n"
+    "movw r20, r18\n"
+    "1:\n"
+    "ld   r22, X+\n"
+    "ld   r23, X+\n"
+    "ld   r24, X+\n"
+    "ld   r25, X+\n"
+    "sbrs r25, 7\n"
+    "rjmp 2f\n"
+    "com  r25\n"
+    "com  r24\n"
+    "com  r23\n"
+    "neg  r22\n"
+    "sbci r23, 0xFF\n"
+    "sbci r24, 0xFF\n"
+    "sbci r25, 0xFF\n"
+    "2:\n"
+    "or   r18, r22\n"
+    "or   r19, r23\n"
+    "or   r20, r24\n"
+    "or   r21, r25\n"
+    "dec  r0\n"
+    "brne 1b\n"
+    "ldi  r24, 0\n"
+    "mov  r22, r18\n"
+    "or   r22, r19\n"
+    "or   r22, r20\n"
+    "or   r22, r21\n"
+    "breq 9f\n"
+    "ldi  r24, 0xFC\n" // -4
+    "3:\n"
+    "sbrc r21, 7\n"
+    "rjmp 4f\n"
+    "lsl  r18\n"
+    "rol  r19\n"
+    "rol  r20\n"
+    "rol  r21\n"
+    "inc  r24\n"
+    "rjmp 3b\n"
+    "4:\n"
+    "ld   r18, Z\n"
+    "ldd  r19, Z+1\n"
+    "ldd  r20, Z+2\n"
+    "ldd  r21, Z+3\n"
+    "mov  r22, r24\n"
+    "tst  r22\n"
+    "breq 7f\n"
+    "brmi 6f\n"
+    "5:\n"
+    "lsl  r18\n"
+    "rol  r19\n"
+    "rol  r20\n"
+    "rol  r21\n"
+    "dec  r22\n"
+    "brne 5b\n"
+    "rjmp 7f\n"
+    "6:\n"
+    "asr  r21\n"
+    "ror  r20\n"
+    "ror  r19\n"
+    "ror  r18\n"
+    "inc  r22\n"
+    "brne 6b\n"
+    "7:\n"
+    "st   Z+, r18\n"
+    "st   Z+, r19\n"
+    "st   Z+, r20\n"
+    "st   Z+, r21\n"
+    "cp   r30, r26\n"
+    "cpc  r31, r27\n"
+    "brne 4b\n"
+    "9:\n"
+    "ret\n"
+    ".text\n");
+inline int8_t normalise(int32_t* v, uint8_t n) {
+    return ll_curve_normalise(v, n);
+}
+#else
 int8_t normalise(int32_t* v, uint8_t n) {
     uint32_t big = 0;
     for (uint8_t i = 0; i < n; ++i) big |= uabs(v[i]); // the largest's top bit
@@ -519,6 +827,7 @@ int8_t normalise(int32_t* v, uint8_t n) {
     }
     return sh;
 }
+#endif
 
 // P' and P'' (x 2^scale) at `off` (Q29) past the current point; with `move`, that point becomes
 // the current one.
@@ -538,7 +847,8 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
     memcpy(v, k.e.dir[0], sizeof(v));
     if (off) {
         int32_t rot[2], h = static_cast<int32_t>(off << 1);
-        rotation(k.clockwise ? -h : h, rot);
+        if (k.clockwise) h = -h;
+        rotation(h, rot);
         rotate(v, rot);
     }
     if (move) memcpy(k.e.dir[0], v, sizeof(v));
@@ -546,7 +856,7 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
     // size is used).
     for (uint8_t i = 0; i < 2; ++i) {
         int32_t a = v[1 - i];
-        if ((i != 0) == k.clockwise) a = -a;
+        if (i == k.clockwise) a = -a;
         d1[i] = mul_q30(k.e.r[i], a);
         d2[i] = mul_q30(k.e.r[i], v[i]);
     }
@@ -556,7 +866,7 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
 __attribute__((noinline)) Num norm(const int32_t v[2], const Track& k, bool with_rise) {
     Num q[3];
     components(v, k.rise, q);
-    return root_sum_squares(q, with_rise ? 3 : 2);
+    return root_sum_squares(q, static_cast<uint8_t>(2 + with_rise));
 }
 
 // The unit tangent (P', w') / |(P', w')| at the current point, Q29. Where P' = 0 (a Bezier whose
@@ -579,6 +889,7 @@ void tangent(Track& k, int32_t out[3]) {
 // widest panel there). On a Bezier, the radius of curvature |P'|^3 / |P' x P''| (x 2^scale) there
 // is kept in k.rmin when it is the smallest so far.
 Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
+    save_run_from_r8();
     int32_t d1[2], d2[2];
     track_at(k, off, move, d1, d2);
     Num n1 = norm(d1, k, false);
@@ -640,10 +951,10 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     k.rise = ld[1].set(uabs(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
-        if (r[0] == 0 || r[1] == 0) return false;
         k.clockwise = cp.clockwise != 0;
         // The sweep in (0, 2 pi], and with the extra full turns, radians.
         span = arc_directions(cp.start_um, cp.end_um, cp.a_um, r, k.clockwise, k.e.dir);
+        if (span == 0) return false; // a null radius
         widest = kWidestArcQ29;
         turns = cp.turns;
         len.set(kTurnQ29, -29).mul(turns).add(Num(span, -29));
@@ -661,10 +972,8 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
         // these fit. w rises by dw per unit of t.
-        const int32_t* p[4] = {cp.start_um, cp.a_um, cp.b_um, cp.end_um};
         for (uint8_t i = 0; i < 2; ++i) {
-            int32_t q[4];
-            for (uint8_t j = 0; j < 4; ++j) q[j] = p[j][i];
+            int32_t q[4] = {cp.start_um[i], cp.a_um[i], cp.b_um[i], cp.end_um[i]};
             differences(q);
             for (uint8_t j = 0; j < 3; ++j) k.b.h[j][i] = (j == 1 ? 6 : 3) * q[j + 1];
         }

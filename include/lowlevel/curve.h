@@ -111,11 +111,13 @@ class CurveWalker {
   private:
     void begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind);
     bool next_piece();
-    /// A piece: its end and 3 x its arms at both ends, ticks x 256 (u, v, w).
+    /// A piece: 3 x its arm at the start, its end and 3 x its arm at the end, ticks x 256 (u, v,
+    /// w); start_piece() turns the three into the cubic's coefficients c1, c2, c3 in place.
     struct Piece {
-        int32_t p3[3], arm0[3], arm3[3];
+        int32_t v[3][3];
     };
-    void start_piece(const Piece& g);
+    enum : uint8_t { kArm0 = 0, kP3 = 1, kArm3 = 2 };
+    void start_piece(Piece& g);
     void arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const;
     void bezier_at(uint16_t at, int32_t point[2], int32_t arm[2]) const;
 
