@@ -1,5 +1,8 @@
 #include "lowlevel/stepgen.h"
 
+#include <stddef.h>
+#include <string.h>
+
 namespace ll {
 namespace {
 
@@ -51,6 +54,16 @@ bool StepGen::begin(const MoveSpec& spec) {
     build_k_table(spec.group);
     ln_.k_err = 0;
     return start_profile(spec, ln_.g.dist[0]);
+}
+
+inline void StepGen::take_spec(const MoveSpec& spec) {
+    static_assert(offsetof(MoveSpec, v_exit2) == offsetof(MoveSpec, v_nominal2) + 4 &&
+                      offsetof(MoveSpec, len_q8) == offsetof(MoveSpec, v_nominal2) + 8,
+                  "v_nominal2, v_exit2, len_q8 in StepGen's order");
+    memcpy(&v_nominal2_, &spec.v_nominal2, 12);
+    feed_ = spec.feed;
+    dv2_.set(spec.dv2 ? spec.dv2 : spec.len_q8);
+    if (!spec.dv2) dv2_.mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
 }
 
 bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
@@ -191,15 +204,6 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     cv_.ref_um = ref_um;
     cv_.x_q8 = 0;
     return start_profile(spec, ref_um);
-}
-
-void StepGen::take_spec(const MoveSpec& spec) {
-    len_q8_ = spec.len_q8;
-    feed_ = spec.feed;
-    v_nominal2_ = spec.v_nominal2;
-    v_exit2_ = spec.v_exit2;
-    dv2_.set(spec.dv2 ? spec.dv2 : spec.len_q8);
-    if (!spec.dv2) dv2_.mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
 }
 
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {

@@ -37,15 +37,16 @@ constexpr uint32_t kMaxPeriodCycles = 256ul * 65000;
 /// One move as the planner hands it over: a straight line, or a curve (seed part IV).
 struct MoveSpec {
     int32_t delta[kAxes]; ///< ticks per machine axis
-    uint32_t len_q8;      ///< length of the regulated path (axes of `group`), µm x 256
     uint32_t accel;       ///< acceleration along the regulated path, mm/min^2 (unless dv2)
     /// 2 a L along the path, (mm/min)^2, as the planner has it (0: from len_q8 and accel). The
     /// profile is derived from it directly, which spares a division.
     uint32_t dv2;
-    uint32_t feed;       ///< nominal speed along the regulated path, mm/min x1000
-    uint32_t v_entry2;   ///< entry speed squared, (mm/min)^2
+    uint32_t feed;     ///< nominal speed along the regulated path, mm/min x1000
+    uint32_t v_entry2; ///< entry speed squared, (mm/min)^2
+    // (v_nominal2, v_exit2, len_q8: in the order of StepGen's copy, one block)
     uint32_t v_nominal2; ///< nominal speed squared, (mm/min)^2
     uint32_t v_exit2;    ///< exit speed squared, (mm/min)^2
+    uint32_t len_q8;     ///< length of the regulated path (axes of `group`), µm x 256
     uint8_t group;       ///< regulated axes G (bit a = machine axis a)
     /// The curve followed from the current position to `delta` further, or nullptr for a line.
     /// Must stay valid until the move is fully produced (the planner keeps it in a slot).
@@ -186,15 +187,16 @@ class StepGen {
     Profile prof_;
     SqrtTracker root_;
     uint32_t delta_root_; ///< d_num / R for the current R
-    uint32_t v_exit2_;    ///< exit speed squared, (mm/min)^2 (MoveSpec)
     uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
     // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
     uint32_t a_hold_;
     uint32_t x2_hold_;
     uint32_t handover_v2_;
     Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
-    // What remains needed of the MoveSpec after begin().
-    uint32_t len_q8_, feed_, v_nominal2_;
+    // What remains needed of the MoveSpec after begin(); the first three in MoveSpec's order
+    // (take_spec() copies them as one block).
+    uint32_t v_nominal2_, v_exit2_, len_q8_;
+    uint32_t feed_;
     Num dv2_; ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
