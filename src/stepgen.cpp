@@ -574,8 +574,11 @@ void StepGen::fill_curve(RunQueue& q) {
 #endif
         // A curve segment costs a chord (a square root) on top of its samples: 8x the line
         // segment duration keeps that cost to a fraction of the time the samples take (one
-        // sample when it needs idle waits).
-        seg_len_ = period_q8 > 0xFFFF00ul ? 1 : next_segment(period_q8 >> 3, 0);
+        // sample when it needs idle waits: period_q8 > 0xFFFF00 makes period_q8 >> 3 a tick of
+        // more than kSegmentCycles, which next_segment() already answers with 1).
+        static_assert((0xFFFF00ul >> 3) >= static_cast<uint32_t>(kSegmentCycles) << 8,
+                      "a period needing idle waits makes one-sample segments");
+        seg_len_ = next_segment(period_q8 >> 3, 0);
         if (cv_.w.done()) finish_move();
     }
 }
