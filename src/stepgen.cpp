@@ -180,10 +180,10 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     // The commanded points: start and end into e, then a and b (arc: centre and semi-axes, of
     // which only the magnitudes count; Bezier: control points).
     const bool arc = c.kind == kCurveArc;
-    int32_t ab[2][2];
+    int32_t(&ab)[2][2] = curve_pts_; // (the started move sets what shares its room)
     for (uint8_t k = 0; k < 2; ++k) {
-        Num per_um(65536);
-        per_um.div(um_q8_per_step_[cv_.axes[k]]); // ticks x 256 per µm
+        Num& per_um = dv2_; // scratch: dv2_ is set by take_spec() (start_profile()) only
+        per_um.set(65536).div(um_q8_per_step_[cv_.axes[k]]); // ticks x 256 per µm
         for (uint8_t i = 0; i < 4; ++i) {
             const int32_t* um = i == 0 ? c.start_um : i == 1 ? c.end_um : i == 2 ? c.a_um : c.b_um;
             int32_t* q8 = i == 0 ? e.start_q8 : i == 1 ? e.end_q8 : ab[i - 2];

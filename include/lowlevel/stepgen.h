@@ -186,11 +186,19 @@ class StepGen {
     uint32_t a_last_; ///< A of the last segment
     Profile prof_;
     SqrtTracker root_;
-    uint32_t delta_root_; ///< d_num / R for the current R
-    uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
-    // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
-    uint32_t a_hold_;
-    uint32_t x2_hold_;
+    // Only a started move uses these four: begin_curve() borrows their room for the curve's
+    // commanded points (its frame then stays below the 64 bytes the ATmega addresses directly).
+    union {
+        struct {
+            uint32_t delta_root_; ///< d_num / R for the current R
+            uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
+            // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
+            uint32_t a_hold_;
+            uint32_t x2_hold_;
+        };
+        int32_t curve_pts_[2][2]; ///< begin_curve(): arc centre and semi-axes, or the Bezier's
+                                  ///< control points, ticks x 256
+    };
     uint32_t handover_v2_;
     Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
     // What remains needed of the MoveSpec after begin(); the first three in MoveSpec's order
