@@ -113,16 +113,15 @@ void StepGen::build_k_table(uint8_t group) {
         }
     }
     lens_valid_ = true;
-    uint32_t sum_hi = 0, sum_lo = 0, count_g = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
-    uint32_t below = 0;                           // dist[i + 1], 0 past the last position
+    uint64_t sum = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
+    uint32_t count_g = 0;
+    uint32_t below = 0; // dist[i + 1], 0 past the last position
     for (uint8_t i = m, set = static_cast<uint8_t>(sets - 1); i-- > 0; set >>= 1) {
         uint32_t n = ln_.g.dist[i] - below;
         below = ln_.g.dist[i];
         uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
         if (len != 0 && n != 0) {
-            uint32_t lo, hi = mul_wide(n, len, lo);
-            sum_lo += lo;
-            sum_hi += hi + (sum_lo < lo);
+            sum += static_cast<uint64_t>(n) * len;
             count_g += n;
         }
     }
@@ -132,7 +131,7 @@ void StepGen::build_k_table(uint8_t group) {
         return;
     }
     Num r(count_g, 20);
-    r.div(num64(sum_hi, sum_lo));
+    r.div(num64(static_cast<uint32_t>(sum >> 32), static_cast<uint32_t>(sum)));
     uint32_t kmax = 0;
     uint32_t* kp = ln_.k;
     for (uint8_t sub = sets; sub; --sub) {
