@@ -184,6 +184,7 @@ class StepGen {
     const CurveParams* curve_;
     uint32_t origin_; ///< reference tick where the profile starts (moves after a resume)
     uint32_t a_last_; ///< A of the last segment
+    uint32_t v_nominal2_, v_exit2_, len_q8_;
     Profile prof_;
     SqrtTracker root_;
     // Only a started move uses these four: begin_curve() borrows their room for the curve's
@@ -203,7 +204,6 @@ class StepGen {
     Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
     // What remains needed of the MoveSpec after begin(); the first three in MoveSpec's order
     // (take_spec() copies them as one block).
-    uint32_t v_nominal2_, v_exit2_, len_q8_;
     uint32_t feed_;
     Num dv2_; ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     const StepLengths* lengths_;
