@@ -15,6 +15,21 @@ uint32_t profile_x2_decel(const Profile& p) {
     return x2;
 }
 
+uint32_t profile_a(const Profile& p, uint32_t x2) {
+    const uint8_t half = static_cast<uint8_t>(p.log_s - 1); // s * x2 / 2 = x2 << half
+    uint32_t travelled = shl_sat(x2, half);
+    // start(x): from A_entry towards A_cruise, clamped there (compared before adding: no
+    // overflow to saturate).
+    const bool up = p.a_entry <= p.a_cruise;
+    uint32_t start = p.a_cruise;
+    if (travelled < (up ? p.a_cruise - p.a_entry : p.a_entry - p.a_cruise))
+        start = up ? p.a_entry + travelled : p.a_entry - travelled;
+    // min(start, A_exit + s (d - x)), the same way.
+    uint32_t to_go2 = 2 * p.d >= x2 ? 2 * p.d - x2 : 0;
+    uint32_t to_go = shl_sat(to_go2, half);
+    return start <= p.a_exit || to_go >= start - p.a_exit ? start : p.a_exit + to_go;
+}
+
 void SqrtTracker::reset(uint32_t a) {
     r = isqrt32(a);
     c = r * r;

@@ -21,8 +21,6 @@
 
 #include <stdint.h>
 
-#include "lowlevel/fixmath.h"
-
 namespace ll {
 
 struct Profile {
@@ -47,19 +45,7 @@ uint32_t profile_x2_decel(const Profile& p);
 ///   A(x) = min(start(x), A_exit + s (d - x)), start(x) = A_entry +- s x clamped at A_cruise.
 /// The profile must be feasible: A_entry <= A_exit + s d (the planner guarantees it), and
 /// s d < 2^31 (the step generator picks s so).
-/// (Inline: the step generator calls it once per segment, from one place.)
-inline uint32_t profile_a(const Profile& p, uint32_t x2) {
-    const uint8_t half = static_cast<uint8_t>(p.log_s - 1); // s * x2 / 2 = x2 << half
-    // A_exit + s (d - x), from the end (compared before adding: no overflow to saturate)
-    uint32_t to_go2 = 2 * p.d >= x2 ? 2 * p.d - x2 : 0;
-    uint32_t to_go = shl_sat(to_go2, half);
-    uint32_t travelled = shl_sat(x2, half);
-    const bool up = p.a_entry <= p.a_cruise;
-    uint32_t start = p.a_cruise;
-    if (travelled < (up ? p.a_cruise - p.a_entry : p.a_entry - p.a_cruise))
-        start = up ? p.a_entry + travelled : p.a_entry - travelled;
-    return start <= p.a_exit || to_go >= start - p.a_exit ? start : p.a_exit + to_go;
-}
+uint32_t profile_a(const Profile& p, uint32_t x2);
 
 /// The integer square root that follows A (seed §8.2), with C = R^2 kept so that a step of R
 /// costs two additions.
