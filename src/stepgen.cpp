@@ -224,11 +224,12 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
     uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);
+    // D 2^m = dn.m 2^(dn.e + m) is below 2^32 - 1 while dn.e + m <= e_lim (D = 0: always).
+    int8_t e_lim = dn.m == 0xFFFFFFFFul ? -1 : 0;
+    if (dn.m == 0) e_lim = 127;
     uint8_t m = 4;
     for (uint32_t lim = 1ul << 22; m > 0; --m, lim <<= 2) {
-        int8_t de = static_cast<int8_t>(dn.e + m); // D 2^m = dn.m 2^de
-        bool d_full = dn.m != 0 && (de > 0 || (de == 0 && dn.m == 0xFFFFFFFFul));
-        if (l_max <= lim && !d_full) break;
+        if (l_max <= lim && static_cast<int8_t>(dn.e + m) <= e_lim) break;
     }
     prof_.log_s = static_cast<uint8_t>(2 * m + 1);
     phi.shift(static_cast<int8_t>(prof_.log_s));
