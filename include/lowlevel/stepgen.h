@@ -168,7 +168,10 @@ class StepGen {
     /// Where the last segment ended, half ticks from origin_.
     uint32_t x2_now() const;
 
-    // Most used first: the ATmega328P addresses the first 64 bytes of an object directly.
+    // Most used first: the ATmega328P addresses the first 64 bytes of an object directly (the
+    // order was measured on the image's size).
+    const StepLengths* lengths_;
+    const Num* um_q8_per_step_;
     bool active_;
     bool holding_;
     bool stopped_;
@@ -184,6 +187,8 @@ class StepGen {
     const CurveParams* curve_;
     uint32_t origin_; ///< reference tick where the profile starts (moves after a resume)
     uint32_t a_last_; ///< A of the last segment
+    // What remains needed of the MoveSpec after begin() (in MoveSpec's order: take_spec() copies
+    // them as one block).
     uint32_t v_nominal2_, v_exit2_, len_q8_;
     Profile prof_;
     SqrtTracker root_;
@@ -201,13 +206,9 @@ class StepGen {
                                   ///< control points, ticks x 256
     };
     uint32_t handover_v2_;
-    Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
-    // What remains needed of the MoveSpec after begin(); the first three in MoveSpec's order
-    // (take_spec() copies them as one block).
-    uint32_t feed_;
-    Num dv2_; ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
-    const StepLengths* lengths_;
-    const Num* um_q8_per_step_;
+    Num a_per_v2_;  ///< A per (mm/min)^2 at the profile's scale
+    uint32_t feed_; ///< nominal speed, mm/min x 1000 (MoveSpec)
+    Num dv2_;       ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     struct LineState {
         uint32_t kmax; ///< largest K of the move
         int32_t k_err; ///< K-time emitted beyond len x Delta_1 so far, Q20 (see fill_line)
