@@ -255,10 +255,10 @@ void StepGen::set_a_exit(uint32_t v_exit2) {
     uint32_t a = a_near(v_exit2);
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
     // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
-    // A_cruise everywhere and the end deceleration starts at its end (what profile_x2_decel
-    // gives then). Chains of short moves are made of such moves.
+    // A_cruise everywhere (delta_at() skips it) and the end deceleration starts at its end
+    // (what profile_x2_decel gives then). Chains of short moves are made of such moves.
     cruising_ = prof_.a_entry == prof_.a_cruise && prof_.a_exit == prof_.a_cruise;
-    x2_decel_ = cruising_ ? 2 * prof_.d : profile_x2_decel(prof_);
+    x2_decel_ = profile_x2_decel(prof_);
 }
 
 void StepGen::set_exit(uint32_t v_exit2) {
