@@ -148,11 +148,6 @@ uint32_t StepGen::a_of(uint32_t v2) const {
     return a > kMaxA ? kMaxA : a;
 }
 
-uint32_t StepGen::a_near(uint32_t v2) const {
-    // Chains of moves mostly enter and leave at their cruise speed: no product then.
-    return v2 == v_nominal2_ ? prof_.a_cruise : a_of(v2);
-}
-
 bool StepGen::begin_curve(const MoveSpec& spec) {
     const CurveParams& c = *spec.curve;
     if (!um_q8_per_step_) return false;
@@ -235,7 +230,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     phi.shift(static_cast<int8_t>(prof_.log_s));
     prof_.d = remaining_ticks;
     prof_.a_cruise = a_of(v_nominal2_);
-    prof_.a_entry = a_near(v_entry2);
+    prof_.a_entry = a_of(v_entry2);
     set_a_exit(v_exit2);
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
@@ -252,7 +247,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
 }
 
 void StepGen::set_a_exit(uint32_t v_exit2) {
-    uint32_t a = a_near(v_exit2);
+    uint32_t a = a_of(v_exit2);
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
     // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
     // A_cruise everywhere (delta_at() skips it) and the end deceleration starts at its end

@@ -140,8 +140,6 @@ class StepGen {
     bool start_profile(const MoveSpec& spec, uint32_t ticks);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
-    /// a_of(v2), A_cruise without a product when v2 is the nominal speed (set A_cruise first).
-    uint32_t a_near(uint32_t v2) const;
     /// Sets prof_.a_exit for the exit speed v_exit2 (at most A_cruise), then x2_decel_ and
     /// cruising_ from prof_.
     void set_a_exit(uint32_t v_exit2);
