@@ -40,7 +40,8 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
         // round(d_j * 2^k / d_1) = floor((2 d_j * 2^k / d_1 + 1) / 2), then in units of
         // 2^(kLineUnit - k) (the same value, aligned: line_advance shifts by a constant).
         uint32_t twice = div_frac(g.dist[j], d1, static_cast<uint8_t>(k + 1));
-        g.slope[j] = ((twice + 1) >> 1) << (kLineUnit - k);
+        g.slope[j] =
+            shl_sat((twice + 1) >> 1, static_cast<uint8_t>(kLineUnit - k)); // (no overflow)
     }
     return true;
 }
