@@ -72,10 +72,9 @@ bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
     have_handover_ = false;
     origin_ = 0;
     prepare_profile(entry, spec.v_exit2, ticks);
-    if (holding_) {
-        a_hold_ = prof_.a_entry;
-        x2_hold_ = 0;
-    }
+    // (read only while holding: a hold begun later sets them again)
+    a_hold_ = prof_.a_entry;
+    x2_hold_ = 0;
     active_ = true;
     stopped_ = false;
     seg_len_ = 1;
