@@ -472,8 +472,10 @@ void StepGen::fill_line(RunQueue& q) {
             if (err < -band) corr = err + band;
             // spread over the segment length in force (a power of two; not a short last one)
             for (uint8_t l = seg_len_; l > 1; l = static_cast<uint8_t>(l >> 1)) corr >>= 1;
-            if (corr > (1l << 18)) corr = 1l << 18; // at most a quarter: no jolt
-            if (corr < -(1l << 18)) corr = -(1l << 18);
+            // at most a quarter: no jolt (one unsigned test of the range; past the band |corr| <=
+            // 2^31 - 2^19, so the sum cannot overflow)
+            if (static_cast<uint32_t>(corr + (1l << 18)) > (1ul << 19))
+                corr = corr < 0 ? -(1l << 18) : 1l << 18;
         }
         const uint32_t d = corr ? less(delta, corr) : delta;
         // At cruise (most segments of a job) the periods are the move's constants.
