@@ -468,8 +468,9 @@ void StepGen::fill_line(RunQueue& q) {
         if (tracked) {
             const int32_t band = 1l << 19;
             const int32_t err = ln_.k_err;
-            corr = err > band ? err - band : 0;
-            if (err < -band) corr = err + band;
+            // beyond the dead band [-band, band] (one unsigned test of the range)
+            if (static_cast<uint32_t>(err) + band > 2ul * band)
+                corr = err < 0 ? err + band : err - band;
             // spread over the segment length in force (a power of two; not a short last one)
             for (uint8_t l = seg_len_; l > 1; l = static_cast<uint8_t>(l >> 1)) corr >>= 1;
             // at most a quarter: no jolt (one unsigned test of the range; past the band |corr| <=
