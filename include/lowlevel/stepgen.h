@@ -167,7 +167,9 @@ class StepGen {
     uint32_t x2_now() const;
 
     // Most used first: the ATmega328P addresses the first 64 bytes of an object directly (the
-    // order was measured on the image's size).
+    // order was measured: image size, and llsegcost's cycles per segment for what delta_at()
+    // reads on every segment).
+    Profile prof_;
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
     bool active_;
@@ -185,11 +187,10 @@ class StepGen {
     const CurveParams* curve_;
     uint32_t origin_; ///< reference tick where the profile starts (moves after a resume)
     uint32_t a_last_; ///< A of the last segment
+    SqrtTracker root_;
     // What remains needed of the MoveSpec after begin() (in MoveSpec's order: take_spec() copies
     // them as one block).
     uint32_t v_nominal2_, v_exit2_, len_q8_;
-    Profile prof_;
-    SqrtTracker root_;
     // Only a started move uses these four: begin_curve() borrows their room for the curve's
     // commanded points (its frame then stays below the 64 bytes the ATmega addresses directly).
     union {
