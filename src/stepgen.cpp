@@ -421,13 +421,14 @@ __attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t
     uint8_t next = 1;
     // A tick lasting kSegmentCycles already makes a one-tick segment, whatever the longest
     // period: its product is only needed below that (and never for k = 0: delta itself).
-    if (delta < static_cast<uint32_t>(kSegmentCycles) << 8 &&
-        (k == 0 || mul_shr(delta, k, 20) <= 0xFFFF00ul)) {
-        uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8; // / next: a shift
-        while (next < kMaxSegmentTicks && delta < target) {
+    // The targets kSegmentCycles << 8 / next are multiples of 2^16: compared on delta's top
+    // half (byte moves), in 8 bits.
+    static_assert(static_cast<uint32_t>(kSegmentCycles) << 8 == 8ul << 16 && kMaxSegmentTicks == 16,
+                  "targets 8, 4, 2, 1 x 2^16");
+    const uint16_t hi = static_cast<uint16_t>(delta >> 16);
+    if (hi < 8 && (k == 0 || mul_shr(delta, k, 20) <= 0xFFFF00ul)) {
+        for (uint8_t t = 8; next < kMaxSegmentTicks && hi < t; t = static_cast<uint8_t>(t >> 1))
             next = static_cast<uint8_t>(next << 1);
-            target >>= 1;
-        }
     }
     return next;
 }
