@@ -352,8 +352,10 @@ void StepGen::push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
 void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8) {
     // Rounded to cycles, at most kMaxPeriodCycles (compared before rounding: no overflow).
     static_assert(kMaxPeriodCycles < 1ul << 24, "kMaxPeriodCycles << 8 fits 32 bits");
-    uint32_t period =
-        period_q8 >= kMaxPeriodCycles << 8 ? kMaxPeriodCycles : (period_q8 + 128) >> 8;
+    static_assert((kMaxPeriodCycles << 8) % 65536 == 0, "compared on the top half");
+    uint32_t period = static_cast<uint16_t>(period_q8 >> 16) >= (kMaxPeriodCycles << 8) >> 16
+                          ? kMaxPeriodCycles
+                          : (period_q8 + 128) >> 8;
     if (period < min_period_) {
         period = min_period_;
 #if LL_STATS
