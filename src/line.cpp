@@ -33,7 +33,7 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     // §7.2: P = 2^k, the smallest power of two with P >= 8 d_1.
     uint32_t d1 = g.dist[0];
     uint8_t k = 3;
-    for (uint32_t p = 1; p < d1; p <<= 1) ++k; // 2^(k - 3) >= d_1; not 1 << k: a shift loop
+    for (uint32_t v = d1 - 1; v; v >>= 1) ++k; // 2^(k - 3) >= d_1: the bits of d_1 - 1
     g.shift = k;
     g.slope[0] = 1ul << kLineUnit;
     for (uint8_t j = 1; j < g.m; ++j) {
