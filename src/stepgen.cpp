@@ -62,8 +62,11 @@ inline void StepGen::take_spec(const MoveSpec& spec) {
                   "v_nominal2, v_exit2, len_q8 in StepGen's order");
     memcpy(&v_nominal2_, &spec.v_nominal2, 12);
     feed_ = spec.feed;
-    dv2_.set(spec.dv2 ? spec.dv2 : spec.len_q8);
-    if (!spec.dv2) dv2_.mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
+    if (spec.dv2) {
+        dv2_.set(spec.dv2);
+    } else {
+        dv2_.set(spec.len_q8).mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
+    }
 }
 
 bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
