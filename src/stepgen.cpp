@@ -269,10 +269,9 @@ void StepGen::set_exit(uint32_t v_exit2) {
 void StepGen::hold() {
     if (holding_) return;
     holding_ = true;
-    if (active_) {
-        a_hold_ = a_last_;
-        x2_hold_ = x2_now();
-    }
+    // (between moves these are unused: start_profile() sets them for the next one)
+    a_hold_ = a_last_;
+    x2_hold_ = x2_now();
 }
 
 void StepGen::resume(uint32_t v_exit2) {
