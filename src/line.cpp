@@ -33,14 +33,15 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     // §7.2: P = 2^k, the smallest power of two with P >= 8 d_1.
     uint32_t d1 = g.dist[0];
     uint8_t k = 3;
-    for (uint32_t p = 1; p < d1; p <<= 1) ++k; // 2^(k - 3) >= d_1; not 1 << k: a shift loop
+    for (uint32_t v = d1 - 1; v; v >>= 1) ++k; // 2^(k - 3) >= d_1: the bits of d_1 - 1
     g.shift = k;
     g.slope[0] = 1ul << kLineUnit;
     for (uint8_t j = 1; j < g.m; ++j) {
         // round(d_j * 2^k / d_1) = floor((2 d_j * 2^k / d_1 + 1) / 2), then in units of
         // 2^(kLineUnit - k) (the same value, aligned: line_advance shifts by a constant).
         uint32_t twice = div_frac(g.dist[j], d1, static_cast<uint8_t>(k + 1));
-        g.slope[j] = ((twice + 1) >> 1) << (kLineUnit - k);
+        g.slope[j] =
+            shl_sat((twice + 1) >> 1, static_cast<uint8_t>(kLineUnit - k)); // (no overflow)
     }
     return true;
 }

@@ -1,5 +1,8 @@
 #include "lowlevel/stepgen.h"
 
+#include <stddef.h>
+#include <string.h>
+
 namespace ll {
 namespace {
 
@@ -53,16 +56,28 @@ bool StepGen::begin(const MoveSpec& spec) {
     return start_profile(spec, ln_.g.dist[0]);
 }
 
+inline void StepGen::take_spec(const MoveSpec& spec) {
+    static_assert(offsetof(MoveSpec, v_exit2) == offsetof(MoveSpec, v_nominal2) + 4 &&
+                      offsetof(MoveSpec, len_q8) == offsetof(MoveSpec, v_nominal2) + 8,
+                  "v_nominal2, v_exit2, len_q8 in StepGen's order");
+    memcpy(&v_nominal2_, &spec.v_nominal2, 12);
+    feed_ = spec.feed;
+    if (spec.dv2) {
+        dv2_.set(spec.dv2);
+    } else {
+        dv2_.set(spec.len_q8).mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
+    }
+}
+
 bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
     take_spec(spec);
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
     prepare_profile(entry, spec.v_exit2, ticks);
-    if (holding_) {
-        a_hold_ = prof_.a_entry;
-        x2_hold_ = 0;
-    }
+    // (read only while holding: a hold begun later sets them again)
+    a_hold_ = prof_.a_entry;
+    x2_hold_ = 0;
     active_ = true;
     stopped_ = false;
     seg_len_ = 1;
@@ -100,16 +115,15 @@ void StepGen::build_k_table(uint8_t group) {
         }
     }
     lens_valid_ = true;
-    uint32_t sum_hi = 0, sum_lo = 0, count_g = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
-    uint32_t below = 0;                           // dist[i + 1], 0 past the last position
+    uint64_t sum = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
+    uint32_t count_g = 0;
+    uint32_t below = 0; // dist[i + 1], 0 past the last position
     for (uint8_t i = m, set = static_cast<uint8_t>(sets - 1); i-- > 0; set >>= 1) {
         uint32_t n = ln_.g.dist[i] - below;
         below = ln_.g.dist[i];
         uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
         if (len != 0 && n != 0) {
-            uint32_t lo, hi = mul_wide(n, len, lo);
-            sum_lo += lo;
-            sum_hi += hi + (sum_lo < lo);
+            sum += static_cast<uint64_t>(n) * len;
             count_g += n;
         }
     }
@@ -119,7 +133,7 @@ void StepGen::build_k_table(uint8_t group) {
         return;
     }
     Num r(count_g, 20);
-    r.div(num64(sum_hi, sum_lo));
+    r.div(num64(static_cast<uint32_t>(sum >> 32), static_cast<uint32_t>(sum)));
     uint32_t kmax = 0;
     uint32_t* kp = ln_.k;
     for (uint8_t sub = sets; sub; --sub) {
@@ -134,11 +148,6 @@ void StepGen::build_k_table(uint8_t group) {
 uint32_t StepGen::a_of(uint32_t v2) const {
     uint32_t a = a_per_v2_.of(v2);
     return a > kMaxA ? kMaxA : a;
-}
-
-uint32_t StepGen::a_near(uint32_t v2) const {
-    // Chains of moves mostly enter and leave at their cruise speed: no product then.
-    return v2 == v_nominal2_ ? prof_.a_cruise : a_of(v2);
 }
 
 bool StepGen::begin_curve(const MoveSpec& spec) {
@@ -167,10 +176,10 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     // The commanded points: start and end into e, then a and b (arc: centre and semi-axes, of
     // which only the magnitudes count; Bezier: control points).
     const bool arc = c.kind == kCurveArc;
-    int32_t ab[2][2];
+    int32_t(&ab)[2][2] = curve_pts_; // (the started move sets what shares its room)
     for (uint8_t k = 0; k < 2; ++k) {
-        Num per_um(65536);
-        per_um.div(um_q8_per_step_[cv_.axes[k]]); // ticks x 256 per µm
+        Num& per_um = dv2_; // scratch: dv2_ is set by take_spec() (start_profile()) only
+        per_um.set(65536).div(um_q8_per_step_[cv_.axes[k]]); // ticks x 256 per µm
         for (uint8_t i = 0; i < 4; ++i) {
             const int32_t* um = i == 0 ? c.start_um : i == 1 ? c.end_um : i == 2 ? c.a_um : c.b_um;
             int32_t* q8 = i == 0 ? e.start_q8 : i == 1 ? e.end_q8 : ab[i - 2];
@@ -194,15 +203,6 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     return start_profile(spec, ref_um);
 }
 
-void StepGen::take_spec(const MoveSpec& spec) {
-    len_q8_ = spec.len_q8;
-    feed_ = spec.feed;
-    v_nominal2_ = spec.v_nominal2;
-    v_exit2_ = spec.v_exit2;
-    dv2_.set(spec.dv2 ? spec.dv2 : spec.len_q8);
-    if (!spec.dv2) dv2_.mul(spec.accel).mulc(0x83126E97ul, -48); // 2 a L
-}
-
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
     const uint32_t d1 = ref_len();
     // From psi = 1 / (dv2 d_1), one division (dv2 = 2 a L, a = 128000 dv2 / len_q8):
@@ -222,17 +222,18 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
     uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);
+    // D 2^m = dn.m 2^(dn.e + m) is below 2^32 - 1 while dn.e + m <= e_lim (D = 0: always).
+    int8_t e_lim = dn.m == 0xFFFFFFFFul ? -1 : 0;
+    if (dn.m == 0) e_lim = 127;
     uint8_t m = 4;
     for (uint32_t lim = 1ul << 22; m > 0; --m, lim <<= 2) {
-        int8_t de = static_cast<int8_t>(dn.e + m); // D 2^m = dn.m 2^de
-        bool d_full = dn.m != 0 && (de > 0 || (de == 0 && dn.m == 0xFFFFFFFFul));
-        if (l_max <= lim && !d_full) break;
+        if (l_max <= lim && static_cast<int8_t>(dn.e + m) <= e_lim) break;
     }
     prof_.log_s = static_cast<uint8_t>(2 * m + 1);
     phi.shift(static_cast<int8_t>(prof_.log_s));
     prof_.d = remaining_ticks;
     prof_.a_cruise = a_of(v_nominal2_);
-    prof_.a_entry = a_near(v_entry2);
+    prof_.a_entry = a_of(v_entry2);
     set_a_exit(v_exit2);
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
@@ -250,13 +251,13 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
 }
 
 void StepGen::set_a_exit(uint32_t v_exit2) {
-    uint32_t a = a_near(v_exit2);
+    uint32_t a = a_of(v_exit2);
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
     // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
-    // A_cruise everywhere and the end deceleration starts at its end (what profile_x2_decel
-    // gives then). Chains of short moves are made of such moves.
+    // A_cruise everywhere (delta_at() skips it) and the end deceleration starts at its end
+    // (what profile_x2_decel gives then). Chains of short moves are made of such moves.
     cruising_ = prof_.a_entry == prof_.a_cruise && prof_.a_exit == prof_.a_cruise;
-    x2_decel_ = cruising_ ? 2 * prof_.d : profile_x2_decel(prof_);
+    x2_decel_ = profile_x2_decel(prof_);
 }
 
 void StepGen::set_exit(uint32_t v_exit2) {
@@ -270,10 +271,9 @@ void StepGen::set_exit(uint32_t v_exit2) {
 void StepGen::hold() {
     if (holding_) return;
     holding_ = true;
-    if (active_) {
-        a_hold_ = a_last_;
-        x2_hold_ = x2_now();
-    }
+    // (between moves these are unused: start_profile() sets them for the next one)
+    a_hold_ = a_last_;
+    x2_hold_ = x2_now();
 }
 
 void StepGen::resume(uint32_t v_exit2) {
@@ -356,8 +356,10 @@ void StepGen::push(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
 void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8) {
     // Rounded to cycles, at most kMaxPeriodCycles (compared before rounding: no overflow).
     static_assert(kMaxPeriodCycles < 1ul << 24, "kMaxPeriodCycles << 8 fits 32 bits");
-    uint32_t period =
-        period_q8 >= kMaxPeriodCycles << 8 ? kMaxPeriodCycles : (period_q8 + 128) >> 8;
+    static_assert((kMaxPeriodCycles << 8) % 65536 == 0, "compared on the top half");
+    uint32_t period = static_cast<uint16_t>(period_q8 >> 16) >= (kMaxPeriodCycles << 8) >> 16
+                          ? kMaxPeriodCycles
+                          : (period_q8 + 128) >> 8;
     if (period < min_period_) {
         period = min_period_;
 #if LL_STATS
@@ -479,12 +481,15 @@ void StepGen::fill_line(RunQueue& q) {
         if (tracked) {
             const int32_t band = 1l << 19;
             const int32_t err = ln_.k_err;
-            corr = err > band ? err - band : 0;
-            if (err < -band) corr = err + band;
+            // beyond the dead band [-band, band] (one unsigned test of the range)
+            if (static_cast<uint32_t>(err) + band > 2ul * band)
+                corr = err < 0 ? err + band : err - band;
             // spread over the segment length in force (a power of two; not a short last one)
             for (uint8_t l = seg_len_; l > 1; l = static_cast<uint8_t>(l >> 1)) corr >>= 1;
-            if (corr > (1l << 18)) corr = 1l << 18; // at most a quarter: no jolt
-            if (corr < -(1l << 18)) corr = -(1l << 18);
+            // at most a quarter: no jolt (one unsigned test of the range; past the band |corr| <=
+            // 2^31 - 2^19, so the sum cannot overflow)
+            if (static_cast<uint32_t>(corr + (1l << 18)) > (1ul << 19))
+                corr = corr < 0 ? -(1l << 18) : 1l << 18;
         }
         const uint32_t d = corr ? less(delta, corr) : delta;
         // At cruise (most segments of a job) the periods are the move's constants.

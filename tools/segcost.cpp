@@ -30,14 +30,14 @@ int main(int argc, char** argv) {
         }
     }
     const std::vector<std::pair<std::string, std::string>> fns = {
-        {"_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE", "StepGen::fill"},
+        {"_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE", "StepGen::fill"},
         {"_ZN2ll12line_advanceERKNS_12LineGeometryERNS_10LineCursorEhPh", "line_advance"},
         {"_ZN2ll11micro_splitEPKhhPNS_8MicroRunE", "micro_split"},
-        {"_ZN2ll7StepGen8delta_atEmRm", "StepGen::delta_at"},
+        {"_ZN2ll7StepGen8delta_atEm", "StepGen::delta_at"},
         {"_ZN2ll9profile_aERKNS_7ProfileEm", "profile_a"},
         {"_ZN2ll11SqrtTracker4seekEm", "SqrtTracker::seek"},
-        {"_ZN2ll7StepGen4emitERNS_7RunRingILh32EEEhhhm", "StepGen::emit"},
-        {"_ZN2ll7StepGen13queued_cyclesERKNS_7RunRingILh32EEE", "StepGen::queued_cycles"},
+        {"_ZN2ll7StepGen4emitERNS_7RunRingILh16EEEhhhm", "StepGen::emit"},
+        {"_ZN2ll7StepGen12horizon_fullERKNS_7RunRingILh16EEE", "StepGen::horizon_full"},
         {"_ZN2ll7mul_shrEmmh", "mul_shr"},
         {"__udivmodsi4", "__udivmodsi4 (32-bit division)"},
         {"_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "StepGen::begin"},

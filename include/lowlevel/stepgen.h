@@ -42,15 +42,16 @@ constexpr uint32_t kMaxPeriodCycles = 256ul * 65000;
 /// One move as the planner hands it over: a straight line, or a curve (seed part IV).
 struct MoveSpec {
     int32_t delta[kAxes]; ///< ticks per machine axis
-    uint32_t len_q8;      ///< length of the regulated path (axes of `group`), µm x 256
     uint32_t accel;       ///< acceleration along the regulated path, mm/min^2 (unless dv2)
     /// 2 a L along the path, (mm/min)^2, as the planner has it (0: from len_q8 and accel). The
     /// profile is derived from it directly, which spares a division.
     uint32_t dv2;
-    uint32_t feed;       ///< nominal speed along the regulated path, mm/min x1000
-    uint32_t v_entry2;   ///< entry speed squared, (mm/min)^2
+    uint32_t feed;     ///< nominal speed along the regulated path, mm/min x1000
+    uint32_t v_entry2; ///< entry speed squared, (mm/min)^2
+    // (v_nominal2, v_exit2, len_q8: in the order of StepGen's copy, one block)
     uint32_t v_nominal2; ///< nominal speed squared, (mm/min)^2
     uint32_t v_exit2;    ///< exit speed squared, (mm/min)^2
+    uint32_t len_q8;     ///< length of the regulated path (axes of `group`), µm x 256
     uint8_t group;       ///< regulated axes G (bit a = machine axis a)
     /// The curve followed from the current position to `delta` further, or nullptr for a line.
     /// Must stay valid until the move is fully produced (the planner keeps it in a slot).
@@ -144,8 +145,6 @@ class StepGen {
     bool start_profile(const MoveSpec& spec, uint32_t ticks);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
-    /// a_of(v2), A_cruise without a product when v2 is the nominal speed (set A_cruise first).
-    uint32_t a_near(uint32_t v2) const;
     /// Sets prof_.a_exit for the exit speed v_exit2 (at most A_cruise), then x2_decel_ and
     /// cruising_ from prof_.
     void set_a_exit(uint32_t v_exit2);
@@ -173,7 +172,12 @@ class StepGen {
     /// Where the last segment ended, half ticks from origin_.
     uint32_t x2_now() const;
 
-    // Most used first: the ATmega328P addresses the first 64 bytes of an object directly.
+    // Most used first: the ATmega328P addresses the first 64 bytes of an object directly (the
+    // order was measured: image size, and llsegcost's cycles per segment for what delta_at()
+    // reads on every segment).
+    Profile prof_;
+    const StepLengths* lengths_;
+    const Num* um_q8_per_step_;
     bool active_;
     bool holding_;
     bool stopped_;
@@ -189,21 +193,27 @@ class StepGen {
     const CurveParams* curve_;
     uint32_t origin_; ///< reference tick where the profile starts (moves after a resume)
     uint32_t a_last_; ///< A of the last segment
-    Profile prof_;
     SqrtTracker root_;
-    uint32_t delta_root_; ///< d_num / R for the current R
-    uint32_t v_exit2_;    ///< exit speed squared, (mm/min)^2 (MoveSpec)
-    uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
-    // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
-    uint32_t a_hold_;
-    uint32_t x2_hold_;
+    // What remains needed of the MoveSpec after begin() (in MoveSpec's order: take_spec() copies
+    // them as one block).
+    uint32_t v_nominal2_, v_exit2_, len_q8_;
+    // Only a started move uses these four: begin_curve() borrows their room for the curve's
+    // commanded points (its frame then stays below the 64 bytes the ATmega addresses directly).
+    union {
+        struct {
+            uint32_t delta_root_; ///< d_num / R for the current R
+            uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
+            // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
+            uint32_t a_hold_;
+            uint32_t x2_hold_;
+        };
+        int32_t curve_pts_[2][2]; ///< begin_curve(): arc centre and semi-axes, or the Bezier's
+                                  ///< control points, ticks x 256
+    };
     uint32_t handover_v2_;
-    Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
-    // What remains needed of the MoveSpec after begin().
-    uint32_t len_q8_, feed_, v_nominal2_;
-    Num dv2_; ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
-    const StepLengths* lengths_;
-    const Num* um_q8_per_step_;
+    Num a_per_v2_;  ///< A per (mm/min)^2 at the profile's scale
+    uint32_t feed_; ///< nominal speed, mm/min x 1000 (MoveSpec)
+    Num dv2_;       ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     struct LineState {
         uint32_t kmax; ///< largest K of the move
         int32_t k_err; ///< K-time emitted beyond len x Delta_1 so far, Q20 (see fill_line)
