@@ -261,7 +261,6 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
     finish_block(b, group, 0, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), unit);
-    for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
     return true;
 }
 
@@ -284,6 +283,7 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t 
     b.v_entry2 = 0;
     ++count_;
     recalculate();
+    memcpy(prev_unit_, unit_in, sizeof(prev_unit_)); // a curve then writes its end tangent
 }
 
 // The deepest stack of the firmware is curve_shape()'s: shape_curve() (inline: curve_shape()

@@ -121,8 +121,8 @@ class Planner {
     /// becomes the last target. Returns false when no axis moves.
     bool open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]);
     /// Completes the block being queued (its deltas, curve and dv2 written): feed (at least 1),
-    /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes. The
-    /// caller then sets prev_unit_ to the direction it ends along.
+    /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes; then
+    /// prev_unit_ = `unit_in` (a curve overwrites it with the direction it ends along).
     void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
                       const int32_t unit_in[kAxes]);
 
