@@ -247,10 +247,10 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     for (uint8_t a = 0, bit = 1; a < kAxes;
          ++a, bit = static_cast<uint8_t>(bit << 1), in_group >>= 1) {
         int32_t du = target_um[a] - last_um_[a];
-        last_um_[a] = target_um[a];
         if (du < 0) neg = static_cast<uint8_t>(neg | bit);
         xu[a] = (in_group & 1) ? abs32(du) : 0;
     }
+    memcpy(last_um_, target_um, sizeof(last_um_));
     Num n = sum_squares(xu, kAxes);
     Num to_unit(1, 29);
     to_unit.div(n.sqrt());
@@ -312,11 +312,9 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     feed = min32(feed, min_over(*m_, kRate, in_plane));
     Num t;
     if (dw_um != 0) {
-        feed = min32(feed, t.set(m_->settings->axis[w].max_rate)
-                               .mul(shape.len_q8)
-                               .div(abs32(dw_um))
-                               .shift(-8)
-                               .u32());
+        feed = min32(
+            feed,
+            t.set(shape.len_q8, -8).mul(m_->settings->axis[w].max_rate).div(abs32(dw_um)).u32());
     }
     const uint32_t accel = curve_accel(*m_, plane, d[w] != 0);
     feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
