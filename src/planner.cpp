@@ -197,9 +197,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
     // 1000.
     uint8_t a = tightest(ax, kAccel, dc);
-    q.sqrt();
-    q.e = static_cast<int8_t>(q.e + 30);
-    q.mulc(k3_6, k3_6e);
+    q.sqrt().mulc(k3_6, 0); // x 2^30 (|d| from sqrt(q)) x 3.6 (k3_6 2^-30)
     r.mul(at_least_1(t.set(ax[a].accel).div(dc[a]).mul(q).u32())).mul(m_->junction_dev_um);
     return r.mulc(kMilli, -41).u32(); // / 1000
 }
