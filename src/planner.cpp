@@ -87,7 +87,7 @@ uint8_t plane_mask(uint8_t plane) {
 // of the plane's two axes bounds it (and the normal axis' when a helix moves it).
 uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
     uint32_t acc = min_over(m, kAccel, w_moves ? 7 : plane_mask(plane));
-    return at_least_1(Num(acc).mul(18).div(5).u32()); // units/s^2 x1000 -> units/min^2
+    return at_least_1(Num(acc).mulc(k3_6, k3_6e).u32()); // units/s^2 x1000 -> units/min^2
 }
 
 // Squared speed of a feed (units/min x1000), (units/min)^2.
