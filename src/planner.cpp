@@ -117,7 +117,9 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
     const AxisSettings* ax = m.settings->axis;
     Num r;
     uint8_t prev = kAxes;
-    for (uint8_t k = 0; k < 2; ++k) {
+    static_assert(offsetof(MoveLimits, accel) == offsetof(MoveLimits, vmax) + 4, "in order");
+    uint32_t* o = &out.vmax; // then out.accel
+    for (uint8_t k = 0; k < 2; ++k, ++o) {
         const Limit which = k ? kAccel : kRate;
         const uint8_t a = tightest(ax, which, x);
         uint32_t v = 0xFFFFFFFFul; // nothing moves
@@ -127,7 +129,7 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
             if (k) r.mulc(k3_6, k3_6e); // units/s^2 x1000 -> units/min^2
             v = at_least_1(r.of(ax[a].*which));
         }
-        (k ? out.accel : out.vmax) = v;
+        *o = v;
     }
 }
 
