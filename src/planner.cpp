@@ -84,9 +84,9 @@ uint8_t plane_mask(uint8_t plane) {
 }
 
 // Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
-// of the plane's two axes bounds it (and the normal axis' when a helix moves it).
-uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
-    uint32_t acc = min_over(m, kAccel, w_moves ? 7 : plane_mask(plane));
+// of the plane's two axes bounds it (and the normal axis' when a helix moves it: `delta`, steps).
+uint32_t curve_accel(const Machine& m, uint8_t plane, const int32_t delta[kAxes]) {
+    uint32_t acc = min_over(m, kAccel, delta[2 - plane] != 0 ? 7 : plane_mask(plane));
     return at_least_1(Num(acc).mulc(k3_6, k3_6e).u32()); // units/s^2 x1000 -> units/min^2
 }
 
@@ -316,7 +316,7 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
             feed,
             t.set(shape.len_q8, -8).mul(m_->settings->axis[w].max_rate).div(abs32(dw_um)).u32());
     }
-    const uint32_t accel = curve_accel(*m_, plane, d[w] != 0);
+    const uint32_t accel = curve_accel(*m_, plane, d);
     feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
     b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
@@ -396,7 +396,7 @@ void Planner::spec_of_first(MoveSpec& s) const {
         s.dv2 = 0;
         if (s.curve) {
             const uint8_t plane = s.curve->plane;
-            s.accel = curve_accel(*m_, plane, s.delta[2 - plane] != 0);
+            s.accel = curve_accel(*m_, plane, s.delta);
         } else {
             MoveLimits lim;
             move_limits(*m_, s.delta, s.group, lim);
