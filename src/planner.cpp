@@ -296,7 +296,6 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     const uint8_t group = m_->group_of[plane == 2 ? 1 : 0];
     const uint8_t in_plane = plane_mask(plane);
     const uint8_t n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
-    const int32_t dw_um = target_um[w] - last_um_[w];
     const uint8_t slot = free_slot_index();
     CurveSlot& s = slot ? curves_[1] : curves_[0];
     const CurveShape& shape = s.shape;
@@ -304,13 +303,14 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     PlanBlock& b = *at(count_);
     int32_t d[kAxes];
     open(b, target, d);
-    memcpy(last_um_, target_um, sizeof(last_um_));
     // Speed: the requested feed, within the plane axes' rates (the tangent takes every
     // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L), and
     // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
     // sqrt(a r 1000) with a in units/min^2 and r in µm.
     feed = min32(feed, min_over(*m_, kRate, in_plane));
     Num t;
+    const int32_t dw_um = target_um[w] - last_um_[w];
+    memcpy(last_um_, target_um, sizeof(last_um_));
     if (dw_um != 0) {
         feed = min32(
             feed,
