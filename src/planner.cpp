@@ -323,8 +323,7 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     place(d, shape.start_dir, plane, n);
     finish_block(b, group, static_cast<uint8_t>(slot + 1), feed, d);
     place(prev_unit_, shape.end_dir, plane, n);
-    s.len_q8 = shape.len_q8;
-    s.params = curve; // over the shape, now used
+    s.queued.params = curve; // over the shape (now used) but its length
 }
 
 void Planner::recalculate(bool all) {
@@ -382,8 +381,8 @@ void Planner::spec_of_first(MoveSpec& s) const {
     if (b->curve) {
         // Slot b->curve - 1 (two slots: no multiplication by the slot size).
         const CurveSlot& c = b->curve == 1 ? curves_[0] : curves_[1];
-        s.curve = &c.params;
-        s.len_q8 = c.len_q8;
+        s.curve = &c.queued.params;
+        s.len_q8 = c.queued.len_q8;
     } else {
         // The length add() had: the same deltas, group and settings (they only change while
         // nothing is queued).

@@ -10,6 +10,8 @@
 // instead of being stored.
 #pragma once
 
+#include <stddef.h>
+
 #include "lowlevel/machine.h"
 #include "lowlevel/stepgen.h"
 
@@ -126,16 +128,19 @@ class Planner {
     void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
                       const int32_t unit_in[kAxes]);
 
-    /// A curve's slot: its parameters and length while its move is queued; before that, while
-    /// the move is being queued, the curve's shape (shape_curve()).
-    struct CurveSlot {
-        union {
-            CurveParams params;
-            CurveShape shape;
-        };
+    /// A curve's slot: its length and parameters while its move is queued; before that, while
+    /// the move is being queued, the curve's shape (shape_curve()). The length leads both (a
+    /// common initial sequence): the shape's stays in place when the parameters replace the rest.
+    struct QueuedCurve {
         uint32_t len_q8; ///< µm x 256
+        CurveParams params;
     };
-    static_assert(sizeof(CurveShape) <= sizeof(CurveParams), "the shape costs no RAM");
+    union CurveSlot {
+        CurveShape shape;
+        QueuedCurve queued;
+    };
+    static_assert(offsetof(CurveShape, len_q8) == 0 && sizeof(CurveShape) <= sizeof(QueuedCurve),
+                  "the shape costs no RAM");
     /// The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
     uint8_t free_slot_index() const {
         static_assert(kCurveSlots == 2, "one free slot out of two");
