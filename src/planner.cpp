@@ -225,9 +225,9 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     // stack of the firmware runs through here.
     PlanBlock& b = *at(count_);
     uint8_t group;
-    MoveLimits lim;
     {
         int32_t d[kAxes];
+        MoveLimits lim;
         if (!open(b, target, d)) {
             memcpy(last_um_, target_um, sizeof(last_um_));
             return false;
@@ -237,6 +237,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000. Num::mul() keeps the top 32 bits
         // of the exact product, as num64(mul_wide()) would.
         b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
+        feed = min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax);
     }
 
     // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
@@ -260,7 +261,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (u > (1ul << 29)) u = 1ul << 29;
         unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
-    finish_block(b, group, 0, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), unit);
+    finish_block(b, group, 0, feed, unit);
     return true;
 }
 
