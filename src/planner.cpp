@@ -261,12 +261,13 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (u > (1ul << 29)) u = 1ul << 29;
         unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
-    finish_block(b, group, 0, feed, unit);
+    finish_block(group, 0, feed, unit);
     return true;
 }
 
-void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
+void Planner::finish_block(uint8_t group, uint8_t curve, uint32_t feed,
                            const int32_t unit_in[kAxes]) {
+    PlanBlock& b = *at(count_);
     b.group = group & 0x3F;
     b.curve = curve & 3;
     b.feed = at_least_1(feed);
@@ -322,7 +323,7 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
     place(d, shape.start_dir, plane, n);
-    finish_block(b, group, static_cast<uint8_t>(slot + 1), feed, d);
+    finish_block(group, static_cast<uint8_t>(slot + 1), feed, d);
     place(prev_unit_, shape.end_dir, plane, n);
     s.queued.params = curve; // over the shape (now used) but its length
 }

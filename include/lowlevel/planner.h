@@ -125,8 +125,7 @@ class Planner {
     /// Completes the block being queued (its deltas, curve and dv2 written): feed (at least 1),
     /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes; then
     /// prev_unit_ = `unit_in` (a curve overwrites it with the direction it ends along).
-    void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
-                      const int32_t unit_in[kAxes]);
+    void finish_block(uint8_t group, uint8_t curve, uint32_t feed, const int32_t unit_in[kAxes]);
 
     /// A curve's slot: its length and parameters while its move is queued; before that, while
     /// the move is being queued, the curve's shape (shape_curve()). The length leads both (a
