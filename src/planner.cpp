@@ -67,11 +67,11 @@ __attribute__((noinline)) uint32_t travel(const Machine& m, const int32_t delta[
     return at_least_1(sum_squares(x, kAxes, group).sqrt().u32());
 }
 
-// The smallest of a limit over the axes X, Y, Z whose bit is set in `mask`.
+// The smallest of a limit over the axes whose bit is set in `mask` (2^32 - 1 for none).
 __attribute__((noinline)) uint32_t min_over(const Machine& m, Limit which, uint8_t mask) {
     uint32_t v = 0xFFFFFFFFul;
     const AxisSettings* ax = m.settings->axis;
-    for (uint8_t a = 0; a < 3; ++a, mask >>= 1) {
+    for (uint8_t a = 0; a < kAxes; ++a, mask >>= 1) {
         if (mask & 1) v = min32(v, ax[a].*which);
     }
     return v;
@@ -159,11 +159,10 @@ __attribute__((noinline)) PlanBlock* Planner::at(uint8_t i) {
 // chain of short segments spends its time; |w| keeps it near reversals.
 uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     uint32_t dc[kAxes];
-    uint32_t a_min = 0xFFFFFFFFul;
-    const AxisSettings* ax = m_->settings->axis;
-    for (uint8_t a = 0; a < kAxes; ++a) {
+    uint8_t moving = 0; // the axes of d
+    for (uint8_t a = 0, bit = 1; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         dc[a] = abs32(unit[a] - prev_unit_[a]); // <= 2^30
-        if (dc[a] != 0) a_min = min32(a_min, ax[a].accel);
+        if (dc[a] != 0) moving = static_cast<uint8_t>(moving | bit);
     }
     // |d|^2 / 4. Exponents are adjusted in place below (no Num::shift()): a zero stays zero
     // whatever its exponent.
@@ -180,7 +179,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // Nearly straight chains of short segments (the common case) stop here.
     Num t, r;
     if (q.e < -32) {
-        t.set(a_min).mul(m_->junction_dev_um);
+        t.set(min_over(*m_, kAccel, moving)).mul(m_->junction_dev_um);
         r.set(limit).mul(q);
         r.e = static_cast<int8_t>(r.e + 10);
         if (t.cmp(r) >= 0) return 0xFFFFFFFFul;
@@ -198,6 +197,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
     // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
     // 1000.
+    const AxisSettings* ax = m_->settings->axis;
     uint8_t a = tightest(ax, kAccel, dc);
     q.sqrt().mulc(k3_6, 0); // x 2^30 (|d| from sqrt(q)) x 3.6 (k3_6 2^-30)
     r.mul(at_least_1(t.set(ax[a].accel).div(dc[a]).mul(q).u32())).mul(m_->junction_dev_um);
