@@ -328,7 +328,7 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     s.queued.params = curve; // over the shape (now used) but its length
 }
 
-void Planner::recalculate(bool all) {
+void Planner::recalculate() {
     // Pointer walks (an index modulo the ring and a 33-byte stride per block cost more than the
     // passes themselves on the ATmega328P).
     PlanBlock* const first = ring_;
@@ -348,7 +348,7 @@ void Planner::recalculate(bool all) {
         uint32_t v = add_sat(next_entry, b->dv2);
         if (v >= b->v_max_entry2) {
             v = b->v_max_entry2;
-            if (!all && first_begun_ && b->v_entry2 == v) {
+            if (first_begun_ && b->v_entry2 == v) {
                 from = pos;
                 break;
             }
@@ -424,9 +424,11 @@ void Planner::restart_first(uint32_t remaining, uint32_t total) {
     if (!count_) return;
     PlanBlock* const b = ring_ + head_;
     if (total != 0) b->dv2 = Num(remaining).div(total).of(b->dv2);
-    b->v_entry2 = 0;
+    // Every move is replanned: as a move not begun yet, whose entry is held at 0 by its limit.
+    b->v_max_entry2 = 0;
+    first_begun_ = 0;
+    recalculate();
     first_begun_ = 1;
-    recalculate(true);
 }
 
 } // namespace ll

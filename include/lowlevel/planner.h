@@ -113,8 +113,9 @@ class Planner {
     uint8_t index(uint8_t i) const { return static_cast<uint8_t>((head_ + i) % kPlannerSize); }
     /// The i-th queued move (0 = oldest; count_ for the one being queued).
     PlanBlock* at(uint8_t i);
-    /// The look-ahead passes; `all`: do not stop where nothing changes (after a restart).
-    void recalculate(bool all = false);
+    /// The look-ahead passes (from the oldest move when it is not begun, else stopping where
+    /// nothing changes any more).
+    void recalculate();
     /// Junction speed squared with the previous move, or any value >= `limit` when it is at
     /// least that (the caller takes the minimum).
     uint32_t junction2(const int32_t unit[kAxes], uint32_t limit) const;
