@@ -276,7 +276,7 @@ void Planner::finish_block(uint8_t group, uint8_t curve, uint32_t feed,
     uint32_t v2 = 0;
     if (count_ > 0) {
         const PlanBlock* prev = at(count_ - 1);
-        if (prev->group == group) {
+        if (static_cast<uint8_t>(prev->group) == group) {
             const uint32_t limit = speed2_of(min32(b.feed, prev->feed));
             v2 = min32(junction2(unit_in, limit), limit);
         }
