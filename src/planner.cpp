@@ -187,21 +187,22 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // The exact formula (rare in chains of short segments).
     // p = 1 - q to 2^-32: near a reversal (p small) its relative error grows to 2^-11 at the
     // 5e-7 threshold, where v_junction^2 is a few (mm/min)^2, well within a unit.
+    // From here q is kept x 2^32 (its mantissa, and so every result's, unchanged): the
+    // exponents below make up for it.
     q.e = static_cast<int8_t>(q.e + 32);
     t.set(~q.u32(), -32);
-    q.e = static_cast<int8_t>(q.e - 32);
     if (tiny(t)) return 0;
     t.sqrt();                      // sin(theta / 2)
-    r.set(1).add(t).mul(t).div(q); // (1 + sin) sin / q
+    r.set(1).add(t).mul(t).div(q); // (1 + sin) sin / q, x 2^-32
     // Acceleration along the junction vector d, limited per axis (GRBL's
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
     // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
     // 1000.
     const AxisSettings* ax = m_->settings->axis;
     uint8_t a = tightest(ax, kAccel, dc);
-    q.sqrt().mulc(k3_6, 0); // x 2^30 (|d| from sqrt(q)) x 3.6 (k3_6 2^-30)
+    q.sqrt().mulc(k3_6, -16); // sqrt(q) 2^16 x 2^14 = |d| in Q29, x 3.6 (k3_6 2^-30)
     r.mul(at_least_1(t.set(ax[a].accel).div(dc[a]).mul(q).u32())).mul(m_->junction_dev_um);
-    return r.mulc(kMilli, -41).u32(); // / 1000
+    return r.mulc(kMilli, -9).u32(); // / 1000 (kMilli 2^-41), x 2^32
 }
 
 bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) {
