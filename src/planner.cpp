@@ -54,9 +54,11 @@ uint8_t tightest(const AxisSettings* ax, Limit which, const uint32_t comp[kAxes]
     return best;
 }
 
-// x <= 5e-7 (GRBL's junction thresholds): 5e-7 = kMicro 2^-52.
+// x <= 5e-7 (GRBL's junction thresholds): 5e-7 = kMicro 2^-52. A zero (exponent 0) is not
+// caught here: junction2()'s q has its exponent lowered by 60 first (a zero q is tiny), and a
+// zero p = 1 - q comes out as a junction speed of 0 from the exact formula, as from tiny().
 __attribute__((noinline)) bool tiny(const Num& x) {
-    return x.m == 0 || x.e < -52 || (x.e == -52 && x.m <= kMicro);
+    return x.e < -52 || (x.e == -52 && x.m <= kMicro);
 }
 
 // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated length:
