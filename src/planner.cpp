@@ -54,9 +54,11 @@ uint8_t tightest(const AxisSettings* ax, Limit which, const uint32_t comp[kAxes]
     return best;
 }
 
-// x <= 5e-7 (GRBL's junction thresholds): 5e-7 = kMicro 2^-52.
+// x <= 5e-7 (GRBL's junction thresholds): 5e-7 = kMicro 2^-52. A zero (exponent 0) is not
+// caught here: junction2()'s q has its exponent lowered by 60 first (a zero q is tiny), and a
+// zero p = 1 - q comes out as a junction speed of 0 from the exact formula, as from tiny().
 __attribute__((noinline)) bool tiny(const Num& x) {
-    return x.m == 0 || x.e < -52 || (x.e == -52 && x.m <= kMicro);
+    return x.e < -52 || (x.e == -52 && x.m <= kMicro);
 }
 
 // Per-axis travel in µm x 256 (units of the axis: mm or degrees), and the regulated length:
@@ -67,11 +69,11 @@ __attribute__((noinline)) uint32_t travel(const Machine& m, const int32_t delta[
     return at_least_1(sum_squares(x, kAxes, group).sqrt().u32());
 }
 
-// The smallest of a limit over the axes X, Y, Z whose bit is set in `mask`.
+// The smallest of a limit over the axes whose bit is set in `mask` (2^32 - 1 for none).
 __attribute__((noinline)) uint32_t min_over(const Machine& m, Limit which, uint8_t mask) {
     uint32_t v = 0xFFFFFFFFul;
     const AxisSettings* ax = m.settings->axis;
-    for (uint8_t a = 0; a < 3; ++a, mask >>= 1) {
+    for (uint8_t a = 0; a < kAxes; ++a, mask >>= 1) {
         if (mask & 1) v = min32(v, ax[a].*which);
     }
     return v;
@@ -84,10 +86,10 @@ uint8_t plane_mask(uint8_t plane) {
 }
 
 // Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
-// of the plane's two axes bounds it (and the normal axis' when a helix moves it).
-uint32_t curve_accel(const Machine& m, uint8_t plane, bool w_moves) {
-    uint32_t acc = min_over(m, kAccel, w_moves ? 7 : plane_mask(plane));
-    return at_least_1(Num(acc).mul(18).div(5).u32()); // units/s^2 x1000 -> units/min^2
+// of the plane's two axes bounds it (and the normal axis' when a helix moves it: `delta`, steps).
+uint32_t curve_accel(const Machine& m, uint8_t plane, const int32_t delta[kAxes]) {
+    uint32_t acc = min_over(m, kAccel, delta[2 - plane] != 0 ? 7 : plane_mask(plane));
+    return at_least_1(Num(acc).mulc(k3_6, k3_6e).u32()); // units/s^2 x1000 -> units/min^2
 }
 
 // Squared speed of a feed (units/min x1000), (units/min)^2.
@@ -117,7 +119,9 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
     const AxisSettings* ax = m.settings->axis;
     Num r;
     uint8_t prev = kAxes;
-    for (uint8_t k = 0; k < 2; ++k) {
+    static_assert(offsetof(MoveLimits, accel) == offsetof(MoveLimits, vmax) + 4, "in order");
+    uint32_t* o = &out.vmax; // then out.accel
+    for (uint8_t k = 0; k < 2; ++k, ++o) {
         const Limit which = k ? kAccel : kRate;
         const uint8_t a = tightest(ax, which, x);
         uint32_t v = 0xFFFFFFFFul; // nothing moves
@@ -127,7 +131,7 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
             if (k) r.mulc(k3_6, k3_6e); // units/s^2 x1000 -> units/min^2
             v = at_least_1(r.of(ax[a].*which));
         }
-        (k ? out.accel : out.vmax) = v;
+        *o = v;
     }
 }
 
@@ -157,11 +161,10 @@ __attribute__((noinline)) PlanBlock* Planner::at(uint8_t i) {
 // chain of short segments spends its time; |w| keeps it near reversals.
 uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     uint32_t dc[kAxes];
-    uint32_t a_min = 0xFFFFFFFFul;
-    const AxisSettings* ax = m_->settings->axis;
-    for (uint8_t a = 0; a < kAxes; ++a) {
+    uint8_t moving = 0; // the axes of d
+    for (uint8_t a = 0, bit = 1; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         dc[a] = abs32(unit[a] - prev_unit_[a]); // <= 2^30
-        if (dc[a] != 0) a_min = min32(a_min, ax[a].accel);
+        if (dc[a] != 0) moving = static_cast<uint8_t>(moving | bit);
     }
     // |d|^2 / 4. Exponents are adjusted in place below (no Num::shift()): a zero stays zero
     // whatever its exponent.
@@ -178,7 +181,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // Nearly straight chains of short segments (the common case) stop here.
     Num t, r;
     if (q.e < -32) {
-        t.set(a_min).mul(m_->junction_dev_um);
+        t.set(min_over(*m_, kAccel, moving)).mul(m_->junction_dev_um);
         r.set(limit).mul(q);
         r.e = static_cast<int8_t>(r.e + 10);
         if (t.cmp(r) >= 0) return 0xFFFFFFFFul;
@@ -186,22 +189,22 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // The exact formula (rare in chains of short segments).
     // p = 1 - q to 2^-32: near a reversal (p small) its relative error grows to 2^-11 at the
     // 5e-7 threshold, where v_junction^2 is a few (mm/min)^2, well within a unit.
+    // From here q is kept x 2^32 (its mantissa, and so every result's, unchanged): the
+    // exponents below make up for it.
     q.e = static_cast<int8_t>(q.e + 32);
     t.set(~q.u32(), -32);
-    q.e = static_cast<int8_t>(q.e - 32);
     if (tiny(t)) return 0;
     t.sqrt();                      // sin(theta / 2)
-    r.set(1).add(t).mul(t).div(q); // (1 + sin) sin / q
+    r.set(1).add(t).mul(t).div(q); // (1 + sin) sin / q, x 2^-32
     // Acceleration along the junction vector d, limited per axis (GRBL's
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
     // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
     // 1000.
+    const AxisSettings* ax = m_->settings->axis;
     uint8_t a = tightest(ax, kAccel, dc);
-    q.sqrt();
-    q.e = static_cast<int8_t>(q.e + 30);
-    q.mulc(k3_6, k3_6e);
+    q.sqrt().mulc(k3_6, -16); // sqrt(q) 2^16 x 2^14 = |d| in Q29, x 3.6 (k3_6 2^-30)
     r.mul(at_least_1(t.set(ax[a].accel).div(dc[a]).mul(q).u32())).mul(m_->junction_dev_um);
-    return r.mulc(kMilli, -41).u32(); // / 1000
+    return r.mulc(kMilli, -9).u32(); // / 1000 (kMilli 2^-41), x 2^32
 }
 
 bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) {
@@ -225,9 +228,9 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     // stack of the firmware runs through here.
     PlanBlock& b = *at(count_);
     uint8_t group;
-    MoveLimits lim;
     {
         int32_t d[kAxes];
+        MoveLimits lim;
         if (!open(b, target, d)) {
             memcpy(last_um_, target_um, sizeof(last_um_));
             return false;
@@ -237,6 +240,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000. Num::mul() keeps the top 32 bits
         // of the exact product, as num64(mul_wide()) would.
         b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
+        feed = min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax);
     }
 
     // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
@@ -247,10 +251,10 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     for (uint8_t a = 0, bit = 1; a < kAxes;
          ++a, bit = static_cast<uint8_t>(bit << 1), in_group >>= 1) {
         int32_t du = target_um[a] - last_um_[a];
-        last_um_[a] = target_um[a];
         if (du < 0) neg = static_cast<uint8_t>(neg | bit);
         xu[a] = (in_group & 1) ? abs32(du) : 0;
     }
+    memcpy(last_um_, target_um, sizeof(last_um_));
     Num n = sum_squares(xu, kAxes);
     Num to_unit(1, 29);
     to_unit.div(n.sqrt());
@@ -260,13 +264,13 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         if (u > (1ul << 29)) u = 1ul << 29;
         unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
     }
-    finish_block(b, group, 0, min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax), unit);
-    for (uint8_t a = 0; a < kAxes; ++a) prev_unit_[a] = unit[a];
+    finish_block(group, 0, feed, unit);
     return true;
 }
 
-void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
+void Planner::finish_block(uint8_t group, uint8_t curve, uint32_t feed,
                            const int32_t unit_in[kAxes]) {
+    PlanBlock& b = *at(count_);
     b.group = group & 0x3F;
     b.curve = curve & 3;
     b.feed = at_least_1(feed);
@@ -275,7 +279,7 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t 
     uint32_t v2 = 0;
     if (count_ > 0) {
         const PlanBlock* prev = at(count_ - 1);
-        if (prev->group == group) {
+        if (static_cast<uint8_t>(prev->group) == group) {
             const uint32_t limit = speed2_of(min32(b.feed, prev->feed));
             v2 = min32(junction2(unit_in, limit), limit);
         }
@@ -284,6 +288,7 @@ void Planner::finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t 
     b.v_entry2 = 0;
     ++count_;
     recalculate();
+    memcpy(prev_unit_, unit_in, sizeof(prev_unit_)); // a curve then writes its end tangent
 }
 
 // The deepest stack of the firmware is curve_shape()'s: shape_curve() (inline: curve_shape()
@@ -296,7 +301,6 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     const uint8_t group = m_->group_of[plane == 2 ? 1 : 0];
     const uint8_t in_plane = plane_mask(plane);
     const uint8_t n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
-    const int32_t dw_um = target_um[w] - last_um_[w];
     const uint8_t slot = free_slot_index();
     CurveSlot& s = slot ? curves_[1] : curves_[0];
     const CurveShape& shape = s.shape;
@@ -304,32 +308,30 @@ void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAx
     PlanBlock& b = *at(count_);
     int32_t d[kAxes];
     open(b, target, d);
-    memcpy(last_um_, target_um, sizeof(last_um_));
     // Speed: the requested feed, within the plane axes' rates (the tangent takes every
     // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L), and
     // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
     // sqrt(a r 1000) with a in units/min^2 and r in µm.
     feed = min32(feed, min_over(*m_, kRate, in_plane));
     Num t;
+    const int32_t dw_um = target_um[w] - last_um_[w];
+    memcpy(last_um_, target_um, sizeof(last_um_));
     if (dw_um != 0) {
-        feed = min32(feed, t.set(m_->settings->axis[w].max_rate)
-                               .mul(shape.len_q8)
-                               .div(abs32(dw_um))
-                               .shift(-8)
-                               .u32());
+        feed = min32(
+            feed,
+            t.set(shape.len_q8, -8).mul(m_->settings->axis[w].max_rate).div(abs32(dw_um)).u32());
     }
-    const uint32_t accel = curve_accel(*m_, plane, d[w] != 0);
+    const uint32_t accel = curve_accel(*m_, plane, d);
     feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
     b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
     // Junctions from the tangents at both ends (w counts only when it is regulated).
     place(d, shape.start_dir, plane, n);
-    finish_block(b, group, static_cast<uint8_t>(slot + 1), feed, d);
+    finish_block(group, static_cast<uint8_t>(slot + 1), feed, d);
     place(prev_unit_, shape.end_dir, plane, n);
-    s.len_q8 = shape.len_q8;
-    s.params = curve; // over the shape, now used
+    s.queued.params = curve; // over the shape (now used) but its length
 }
 
-void Planner::recalculate(bool all) {
+void Planner::recalculate() {
     // Pointer walks (an index modulo the ring and a 33-byte stride per block cost more than the
     // passes themselves on the ATmega328P).
     PlanBlock* const first = ring_;
@@ -349,7 +351,7 @@ void Planner::recalculate(bool all) {
         uint32_t v = add_sat(next_entry, b->dv2);
         if (v >= b->v_max_entry2) {
             v = b->v_max_entry2;
-            if (!all && first_begun_ && b->v_entry2 == v) {
+            if (first_begun_ && b->v_entry2 == v) {
                 from = pos;
                 break;
             }
@@ -384,8 +386,8 @@ void Planner::spec_of_first(MoveSpec& s) const {
     if (b->curve) {
         // Slot b->curve - 1 (two slots: no multiplication by the slot size).
         const CurveSlot& c = b->curve == 1 ? curves_[0] : curves_[1];
-        s.curve = &c.params;
-        s.len_q8 = c.len_q8;
+        s.curve = &c.queued.params;
+        s.len_q8 = c.queued.len_q8;
     } else {
         // The length add() had: the same deltas, group and settings (they only change while
         // nothing is queued).
@@ -398,7 +400,7 @@ void Planner::spec_of_first(MoveSpec& s) const {
         s.dv2 = 0;
         if (s.curve) {
             const uint8_t plane = s.curve->plane;
-            s.accel = curve_accel(*m_, plane, s.delta[2 - plane] != 0);
+            s.accel = curve_accel(*m_, plane, s.delta);
         } else {
             MoveLimits lim;
             move_limits(*m_, s.delta, s.group, lim);
@@ -425,9 +427,11 @@ void Planner::restart_first(uint32_t remaining, uint32_t total) {
     if (!count_) return;
     PlanBlock* const b = ring_ + head_;
     if (total != 0) b->dv2 = Num(remaining).div(total).of(b->dv2);
-    b->v_entry2 = 0;
+    // Every move is replanned: as a move not begun yet, whose entry is held at 0 by its limit.
+    b->v_max_entry2 = 0;
+    first_begun_ = 0;
+    recalculate();
     first_begun_ = 1;
-    recalculate(true);
 }
 
 } // namespace ll

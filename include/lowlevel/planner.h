@@ -10,6 +10,8 @@
 // instead of being stored.
 #pragma once
 
+#include <stddef.h>
+
 #include "lowlevel/machine.h"
 #include "lowlevel/stepgen.h"
 
@@ -34,8 +36,8 @@ struct PlanBlock {
 /// the group or following it, kept within its own maximum rate and acceleration).
 struct MoveLimits {
     uint32_t len_q8; ///< µm x 256
-    uint32_t accel;  ///< units/min^2
     uint32_t vmax;   ///< units/min x1000
+    uint32_t accel;  ///< units/min^2 (after vmax: move_limits() writes them in this order)
 };
 void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out);
 
@@ -111,8 +113,9 @@ class Planner {
     uint8_t index(uint8_t i) const { return static_cast<uint8_t>((head_ + i) % kPlannerSize); }
     /// The i-th queued move (0 = oldest; count_ for the one being queued).
     PlanBlock* at(uint8_t i);
-    /// The look-ahead passes; `all`: do not stop where nothing changes (after a restart).
-    void recalculate(bool all = false);
+    /// The look-ahead passes (from the oldest move when it is not begun, else stopping where
+    /// nothing changes any more).
+    void recalculate();
     /// Junction speed squared with the previous move, or any value >= `limit` when it is at
     /// least that (the caller takes the minimum).
     uint32_t junction2(const int32_t unit[kAxes], uint32_t limit) const;
@@ -121,21 +124,23 @@ class Planner {
     /// becomes the last target. Returns false when no axis moves.
     bool open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]);
     /// Completes the block being queued (its deltas, curve and dv2 written): feed (at least 1),
-    /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes. The
-    /// caller then sets prev_unit_ to the direction it ends along.
-    void finish_block(PlanBlock& b, uint8_t group, uint8_t curve, uint32_t feed,
-                      const int32_t unit_in[kAxes]);
+    /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes; then
+    /// prev_unit_ = `unit_in` (a curve overwrites it with the direction it ends along).
+    void finish_block(uint8_t group, uint8_t curve, uint32_t feed, const int32_t unit_in[kAxes]);
 
-    /// A curve's slot: its parameters and length while its move is queued; before that, while
-    /// the move is being queued, the curve's shape (shape_curve()).
-    struct CurveSlot {
-        union {
-            CurveParams params;
-            CurveShape shape;
-        };
+    /// A curve's slot: its length and parameters while its move is queued; before that, while
+    /// the move is being queued, the curve's shape (shape_curve()). The length leads both (a
+    /// common initial sequence): the shape's stays in place when the parameters replace the rest.
+    struct QueuedCurve {
         uint32_t len_q8; ///< µm x 256
+        CurveParams params;
     };
-    static_assert(sizeof(CurveShape) <= sizeof(CurveParams), "the shape costs no RAM");
+    union CurveSlot {
+        CurveShape shape;
+        QueuedCurve queued;
+    };
+    static_assert(offsetof(CurveShape, len_q8) == 0 && sizeof(CurveShape) <= sizeof(QueuedCurve),
+                  "the shape costs no RAM");
     /// The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
     uint8_t free_slot_index() const {
         static_assert(kCurveSlots == 2, "one free slot out of two");
