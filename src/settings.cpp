@@ -59,11 +59,18 @@ const Row kRows[] LL_PROGMEM = {
 #undef LL_ROW
 constexpr uint8_t kRowCount = sizeof(kRows) / sizeof(kRows[0]);
 
-// The field of `row` for axis `a` (0 for the machine-wide rows).
-uint8_t* field(const Row* row, uint8_t kind, uint8_t a) {
-    uint8_t stride = kind == kGroup ? 1 : sizeof(AxisSettings);
-    return reinterpret_cast<uint8_t*>(&g_settings) + flash_read_byte(&row->offset) +
-           static_cast<uint8_t>(a * stride);
+// The field that holds `$n` and its kind; nullptr when no row has that number.
+uint8_t* find(uint8_t n, uint8_t& kind) {
+    for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
+        uint8_t first = flash_read_byte(&row->number);
+        uint8_t a = static_cast<uint8_t>(n - first);
+        if (a >= (first >= kFirstAxisNumber ? kAxes : 1)) continue;
+        kind = flash_read_byte(&row->kind);
+        uint8_t stride = kind == kGroup ? 1 : sizeof(AxisSettings);
+        return reinterpret_cast<uint8_t*>(&g_settings) + flash_read_byte(&row->offset) +
+               static_cast<uint8_t>(a * stride);
+    }
+    return nullptr;
 }
 
 // Fletcher-style 16-bit check over the record (two running 8-bit sums), computed while it is
@@ -144,53 +151,48 @@ void save_coord(const int32_t (&um)[kAxes]) {
 
 uint8_t store(uint8_t n, const num::Decimal& value) {
     if (value.negative()) return status::kNegativeValue;
-    for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
-        uint8_t first = flash_read_byte(&row->number);
-        uint8_t a = static_cast<uint8_t>(n - first);
-        if (a >= (first >= kFirstAxisNumber ? kAxes : 1)) continue;
-        uint8_t kind = flash_read_byte(&row->kind);
-        uint8_t* f = field(row, kind, a);
-        if (kind >= kMilli) {
-            int32_t milli;
-            if (!num::to_milli(value, milli)) return status::kInvalidStatement;
-            if (milli == 0 && kind == kMilliPos) return status::kNegativeValue;
-            memcpy(f, &milli, sizeof(milli));
-        } else {
-            uint32_t v;
-            static_assert(kByte == 0 && kBool == 1 && kPulse == 2 && kGroup == 3 && kMilli == 4,
-                          "kMax follows the kinds");
-            static const uint8_t kMax[kMilli] LL_PROGMEM = {255, 1, 255, kAxes - 1}; // by kind
-            uint8_t max = flash_read_byte(&kMax[kind]);
-            if (!num::to_uint(value, max, v)) return status::kInvalidStatement;
-            if (kind == kPulse && v < 3) return status::kStepPulseMin;
-            *f = static_cast<uint8_t>(v);
-        }
-        save();
-        return status::kOk;
+    uint8_t kind;
+    uint8_t* f = find(n, kind);
+    if (f == nullptr) return status::kInvalidStatement;
+    if (kind >= kMilli) {
+        int32_t milli;
+        if (!num::to_milli(value, milli)) return status::kInvalidStatement;
+        if (milli == 0 && kind == kMilliPos) return status::kNegativeValue;
+        memcpy(f, &milli, sizeof(milli));
+    } else {
+        uint32_t v;
+        static_assert(kByte == 0 && kBool == 1 && kPulse == 2 && kGroup == 3 && kMilli == 4,
+                      "kMax follows the kinds");
+        static const uint8_t kMax[kMilli] LL_PROGMEM = {255, 1, 255, kAxes - 1}; // by kind
+        uint8_t max = flash_read_byte(&kMax[kind]);
+        if (!num::to_uint(value, max, v)) return status::kInvalidStatement;
+        if (kind == kPulse && v < 3) return status::kStepPulseMin;
+        *f = static_cast<uint8_t>(v);
     }
-    return status::kInvalidStatement;
+    save();
+    return status::kOk;
 }
 
 void report() {
-    for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
-        uint8_t first = flash_read_byte(&row->number);
-        uint8_t kind = flash_read_byte(&row->kind);
-        uint8_t count = first >= kFirstAxisNumber ? kAxes : 1;
-        for (uint8_t a = 0; a < count; ++a) {
-            const uint8_t* f = field(row, kind, a);
-            out::ch('$');
-            out::u8(static_cast<uint8_t>(first + a));
-            out::ch('=');
-            if (kind >= kMilli) {
-                int32_t milli;
-                memcpy(&milli, f, sizeof(milli));
-                out::fixed(milli, 3);
-            } else {
-                out::u8(*f);
-            }
-            out::eol();
+    // Every number in turn, looked up as `$N=` would be: the rows are in increasing order, so
+    // this prints them in `$$` order without a second walk over the table.
+    uint8_t n = 0;
+    do {
+        uint8_t kind;
+        const uint8_t* f = find(n, kind);
+        if (f == nullptr) continue;
+        out::ch('$');
+        out::u8(n);
+        out::ch('=');
+        if (kind >= kMilli) {
+            int32_t milli;
+            memcpy(&milli, f, sizeof(milli));
+            out::fixed(milli, 3);
+        } else {
+            out::u8(*f);
         }
-    }
+        out::eol();
+    } while (++n != 0);
 }
 
 } // namespace settings
