@@ -228,7 +228,11 @@ void position(int32_t steps[kAxes]) {
     // between the consumer and the producer.
     for (;;) {
         for (uint8_t a = 0; a < kAxes; ++a, s >>= 1, d >>= 1) {
-            if (s & 1) steps[a] += (d & 1) ? n : -static_cast<int16_t>(n);
+            if (s & 1) {
+                int16_t dn = n;
+                if (!(d & 1)) dn = static_cast<int16_t>(-dn);
+                steps[a] += dn;
+            }
         }
         if (i == g_runs.tail) return;
         const Run& r = g_runs.buf[i];
