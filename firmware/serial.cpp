@@ -143,7 +143,8 @@ void serial_put(uint8_t byte) {
         // Full, so a transmission is under way: the interrupt frees a slot within two frames.
     }
     s_tx_buf[t & (kTxSize - 1)] = byte;
-    s_tx_tail = static_cast<uint8_t>(t + 1);
+    t = static_cast<uint8_t>(t + 1);
+    s_tx_tail = t;
     uint8_t was_active;
     {
         fw::IrqGuard g; // test-and-set, 4 cycles
@@ -152,10 +153,10 @@ void serial_put(uint8_t byte) {
     }
     if (!was_active) {
         // The transmitter was idle and no completion is pending, so the interrupt cannot run
-        // before this byte has left: take it from the ring here.
-        uint8_t h = s_tx_head;
-        UDR0 = s_tx_buf[h & (kTxSize - 1)];
-        s_tx_head = static_cast<uint8_t>(h + 1);
+        // before this byte has left: take it from the ring here. The ring was empty (the
+        // interrupt found it so before it cleared s_tx_active), so it is this byte.
+        UDR0 = byte;
+        s_tx_head = t;
     }
 }
 

@@ -120,7 +120,13 @@ __attribute__((noinline)) void report_status() {
         if (flash_read_byte(s++) == 0) --name;
     }
     out::str(reinterpret_cast<const FlashChar*>(s));
-    int32_t pos[kAxes], wco[kAxes];
+    // In the motion side's scratch RAM (motion.h): no frame to build, 32 B less stack.
+    struct Coords {
+        int32_t pos[kAxes], wco[kAxes];
+    };
+    Coords& c = motion::scratch<Coords>();
+    int32_t* pos = c.pos;
+    int32_t(&wco)[kAxes] = c.wco;
     motion::position(pos);
     gcode::steps_to_um(pos, pos);
     gcode::work_offset(wco);
