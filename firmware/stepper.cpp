@@ -266,13 +266,15 @@ void stepper_configure(const StepperConfig& cfg) {
     uint16_t pulse = st::effective_pulse(cfg.pulse_cycles);
     s_ocr1b = static_cast<uint16_t>(pulse - 1 + st::kPulseGuard);
     s_min_period = st::min_period(cfg.pulse_cycles);
-    s_idle_d = board::step_port_bits<Port::D>(cfg.step_invert);
-    s_idle_b = board::step_port_bits<Port::B>(cfg.step_invert);
+    uint8_t idle_d = board::step_port_bits<Port::D>(cfg.step_invert);
+    uint8_t idle_b = board::step_port_bits<Port::B>(cfg.step_invert);
+    s_idle_d = idle_d;
+    s_idle_b = idle_b;
     s_dir_invert = cfg.dir_invert;
     s_enable_invert = cfg.enable_invert ? 1 : 0;
     fw::IrqGuard g;
-    PORTD = static_cast<uint8_t>((PORTD & ~board::kStepMaskD) | s_idle_d);
-    PORTB = static_cast<uint8_t>((PORTB & ~board::kStepMaskB) | s_idle_b);
+    PORTD = static_cast<uint8_t>((PORTD & ~board::kStepMaskD) | idle_d);
+    PORTB = static_cast<uint8_t>((PORTB & ~board::kStepMaskB) | idle_b);
 }
 
 void stepper_start() {
@@ -280,8 +282,11 @@ void stepper_start() {
     const Run& r = g_runs.front();
     uint8_t steps = r.steps;
     uint8_t dirs = r.dirs;
-    uint16_t period = r.period < s_min_period ? s_min_period : r.period;
-    g_exec.remaining = r.count;
+    uint8_t count = r.count; // read before the volatile guard: r is not looked up again
+    uint16_t period = r.period;
+    uint16_t min_period = s_min_period;
+    if (period < min_period) period = min_period;
+    g_exec.remaining = count;
     g_exec.steps = steps;
     g_exec.dirs = dirs;
     g_exec.starved = 0;

@@ -78,6 +78,11 @@ __attribute__((noinline)) void reset_planner(Motion& m, const int32_t here[kAxes
     m.planner.reset(here, um);
 }
 
+// Nothing queued for the step interrupt and nothing running.
+__attribute__((noinline)) bool drained() {
+    return g_runs.empty() && !g_exec.running;
+}
+
 __attribute__((noinline)) void enable(Motion& m, bool on) {
     if (m.enabled == on) return;
     m.enabled = on;
@@ -141,7 +146,7 @@ uint8_t blocks_free() {
 
 void poll() {
     Motion& m = mo();
-    if (m.state == State::Idle && m.planner.empty() && g_runs.empty() && !g_exec.running) {
+    if (m.state == State::Idle && m.planner.empty() && drained()) {
         if (m.enabled && g_settings.idle_delay_ms != 255 &&
             static_cast<uint16_t>(hal::millis() - m.idle_since) >= g_settings.idle_delay_ms) {
             enable(m, false);
@@ -160,7 +165,7 @@ void poll() {
             hal::stepper_start();
         }
     }
-    if (!g_runs.empty() || g_exec.running) return; // not drained
+    if (!drained()) return;
     if (m.state == State::Holding) {
         if (m.gen.stopped() || !pending) m.state = State::Held;
     } else if (m.state == State::Cycle && !pending) {
