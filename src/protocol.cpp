@@ -164,16 +164,20 @@ __attribute__((noinline)) void report_status() {
 
 // `$N=value`.
 uint8_t store_setting() {
-    num::Decimal n, v;
-    const char* s = num::parse(p.line + 1, n);
+    // In the motion side's scratch RAM (motion.h), as the status report's coordinates: no frame.
+    struct Words {
+        num::Decimal n, v;
+        uint32_t number;
+    };
+    Words& w = motion::scratch<Words>();
+    const char* s = num::parse(p.line + 1, w.n);
     if (s == nullptr) return kBadNumberFormat;
     if (*s++ != '=') return kInvalidStatement;
-    uint32_t number;
-    if (!num::to_uint(n, 255u, number)) return kInvalidStatement;
-    s = num::parse(s, v);
+    if (!num::to_uint(w.n, 255u, w.number)) return kInvalidStatement;
+    s = num::parse(s, w.v);
     if (s == nullptr) return kBadNumberFormat;
     if (*s != 0) return kInvalidStatement;
-    uint8_t r = settings::store(static_cast<uint8_t>(number), v);
+    uint8_t r = settings::store(static_cast<uint8_t>(w.number), w.v);
     if (r == kOk) {
         motion::settings_changed();
         gcode::settings_changed();
@@ -238,7 +242,8 @@ __attribute__((noinline)) uint8_t system_command() {
             settings::restore_defaults(); // also zeroes G54
             motion::settings_changed();
         } else {
-            int32_t zero[kAxes] = {};
+            int32_t(&zero)[kAxes] = motion::scratch<int32_t[kAxes]>(); // no frame
+            memset(zero, 0, sizeof(zero));
             settings::save_coord(zero);
         }
         out::msg(LL_PSTR("Restoring defaults"));

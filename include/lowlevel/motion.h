@@ -24,8 +24,8 @@ struct LineRequest {
 /// (gcode.cpp), live from gcode::execute() until push_line() has queued the move: push_line()
 /// only polls once the move is in the planner, and execute() never polls. Sharing it saves RAM
 /// on the deepest stack (the move handed over was a local of poll()). The status report
-/// (protocol.cpp), which runs neither inside poll() nor inside execute() and polls nothing, keeps
-/// its coordinates there too.
+/// (protocol.cpp) and the `$` commands, which run neither inside poll() nor inside execute() and
+/// poll nothing, keep their coordinates and numbers there too.
 // The size of the G-code work block on the AVR (gcode.cpp checks it), generous on the host.
 constexpr uint16_t kScratchBytes =
     sizeof(void*) == 2 ? 92 + 16 * kAxes + (kAxes > 5 ? 2 : 0) : 128 + 32 * kAxes;
