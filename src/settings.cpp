@@ -76,24 +76,25 @@ uint8_t* find(uint8_t n, uint8_t& kind) {
 // Fletcher-style 16-bit check over the record (two running 8-bit sums), computed while it is
 // read or written: catches changed, swapped and zeroed bytes, and a blank (all 0xFF) record
 // never matches its own check. Returns true when a read record matches its check.
+// Writes v at addr and returns it, or (write false) returns the byte at addr.
+__attribute__((noinline)) uint8_t transfer(uint16_t addr, uint8_t v, bool write) {
+    if (!write) return hal::eeprom_read(addr);
+    hal::eeprom_write(addr, v);
+    return v;
+}
+
 bool record(uint16_t addr, void* data, uint8_t n, bool write) {
     uint8_t* p = static_cast<uint8_t*>(data);
     uint8_t a = 0x5A, b = 0xA5;
     for (uint8_t i = 0; i < n; ++i, ++addr) {
-        if (write) {
-            hal::eeprom_write(addr, p[i]);
-        } else {
-            p[i] = hal::eeprom_read(addr);
-        }
-        a = static_cast<uint8_t>(a + p[i]);
+        uint8_t v = transfer(addr, p[i], write);
+        p[i] = v; // unchanged when writing
+        a = static_cast<uint8_t>(a + v);
         b = static_cast<uint8_t>(b + a);
     }
-    if (write) {
-        hal::eeprom_write(addr, a);
-        hal::eeprom_write(static_cast<uint16_t>(addr + 1), b);
-        return true;
-    }
-    return hal::eeprom_read(addr) == a && hal::eeprom_read(static_cast<uint16_t>(addr + 1)) == b;
+    // Writing, both compare equal (and both bytes are written: no short cut).
+    return transfer(addr, a, write) == a &&
+           transfer(static_cast<uint16_t>(addr + 1), b, write) == b;
 }
 
 // GRBL 1.1h's generic machine, $10=3 and the speed groups X Y Z -> 0, A B C -> 1.
