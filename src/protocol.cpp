@@ -304,8 +304,9 @@ void read_line() {
             p.lost_after = static_cast<uint8_t>(p.rx_capacity - free);
             if (p.lost_after == 0) p.flags |= kLost;
         }
-        uint8_t c;
-        if (!hal::serial_get(c)) return;
+        uint8_t got;
+        if (!hal::serial_get(got)) return;
+        uint8_t c = got;
         bool end = false;
         uint8_t f = p.flags;
         if (c == '\n' || c == '\r') {
