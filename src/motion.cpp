@@ -72,6 +72,16 @@ void position_um(Motion& m, const int32_t steps[kAxes], int32_t um[kAxes]) {
     }
 }
 
+// Where the machine is while the planner is reset (abort(), settings_changed()), in the scratch
+// RAM: those run outside poll() and gcode::execute() (motion.h), and their frames shrink.
+struct Here {
+    int32_t steps[kAxes];
+    hal::StepperConfig cfg; // settings_changed()
+};
+inline Here& here_scratch() {
+    return scratch<Here>();
+}
+
 __attribute__((noinline)) void reset_planner(Motion& m, const int32_t here[kAxes]) {
     int32_t um[kAxes];
     position_um(m, here, um);
@@ -212,7 +222,7 @@ void cycle_start() {
 
 bool abort() {
     bool moving = g_exec.running != 0;
-    int32_t here[kAxes];
+    int32_t* here = here_scratch().steps;
     position(here);
     restart(mo(), here);
     return moving;
@@ -259,13 +269,13 @@ void settings_changed() {
     machine_build(m.machine, g_settings);
     m.planner.configure(&m.machine);
     m.gen.configure(&m.machine.lengths, m.machine.min_period, m.machine.um_q8_per_step);
-    hal::StepperConfig cfg;
+    hal::StepperConfig& cfg = here_scratch().cfg;
     cfg.pulse_cycles = static_cast<uint16_t>(g_settings.pulse_us * (kCpuHz / 1000000));
     cfg.step_invert = g_settings.step_invert;
     cfg.dir_invert = g_settings.dir_invert;
     cfg.enable_invert = g_settings.enable_invert;
     hal::stepper_configure(cfg);
-    int32_t here[kAxes];
+    int32_t* here = here_scratch().steps;
     position(here);
     reset_planner(m, here);
     if (g_settings.idle_delay_ms == 255) enable(m, true);
