@@ -1,6 +1,8 @@
 // motion.h on top of the planner, the step generator and the run queue.
 #include "lowlevel/motion.h"
 
+#include <string.h>
+
 #include "lowlevel/hal.h"
 #include "lowlevel/planner.h"
 #include "lowlevel/run_queue.h"
@@ -122,7 +124,8 @@ void restart(Motion& m, const int32_t here[kAxes]) {
 alignas(alignof(void*)) uint8_t g_scratch[kScratchBytes]; // 1 on the AVR, 8 on the host
 
 void init() {
-    int32_t zero[kAxes] = {};
+    int32_t* zero = here_scratch().steps;
+    memset(zero, 0, sizeof(Here::steps));
     restart(mo(), zero);
     mo().enabled = false;
     g_starvations = 0;
