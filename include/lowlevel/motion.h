@@ -25,7 +25,7 @@ struct LineRequest {
 /// only polls once the move is in the planner, and execute() never polls. Sharing it saves RAM
 /// on the deepest stack (the move handed over was a local of poll()). The status report
 /// (protocol.cpp) and the `$` commands, which run neither inside poll() nor inside execute() and
-/// poll nothing, keep their coordinates and numbers there too, as do abort() and
+/// poll nothing, keep their coordinates and numbers there too, as do init(), abort() and
 /// settings_changed().
 // The size of the G-code work block on the AVR (gcode.cpp checks it), generous on the host.
 constexpr uint16_t kScratchBytes =
