@@ -242,9 +242,7 @@ __attribute__((noinline)) uint8_t system_command() {
             settings::restore_defaults(); // also zeroes G54
             motion::settings_changed();
         } else {
-            int32_t(&zero)[kAxes] = motion::scratch<int32_t[kAxes]>(); // no frame
-            memset(zero, 0, sizeof(zero));
-            settings::save_coord(zero);
+            settings::clear_coord();
         }
         out::msg(LL_PSTR("Restoring defaults"));
         return kOkThenReset;

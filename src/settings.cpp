@@ -126,6 +126,10 @@ void save() {
 void restore_defaults() {
     flash_copy(&g_settings, &kDefaults, sizeof(Settings));
     save();
+    clear_coord();
+}
+
+void clear_coord() {
     int32_t zero[kAxes] = {};
     save_coord(zero);
 }
