@@ -254,7 +254,11 @@ void stepper_init() {
     TCCR1A = 0;
     TIMSK1 = _BV(OCIE1A) | _BV(OCIE1B); // the timer only runs while there are runs
     GPIOR0 = 0;
-    hal::stepper_configure(hal::StepperConfig{160, 0, 0, 0});
+    // What stepper_configure(StepperConfig{160, 0, 0, 0}) would do: 10 us pulses, nothing
+    // inverted. The masks and step pins are already 0 (static RAM, board_init()).
+    constexpr uint16_t kBootPulse = 160;
+    s_ocr1b = static_cast<uint16_t>(st::effective_pulse(kBootPulse) - 1 + st::kPulseGuard);
+    s_min_period = st::min_period(kBootPulse);
     hal::stepper_enable(false);
 }
 
