@@ -222,10 +222,10 @@ __attribute__((noinline)) uint8_t system_command() {
         if (c == '#') {
             gcode::report_offsets();
         } else {
-            out::str(
-                LL_PSTR("[VER:1.1h." LL_BUILD_DATE ":Low Level " LL_VERSION_STRING "]\r\n[OPT:I,"));
-            out::u8(kPlannerSize); // the ring holds kPlannerSize moves
-            out::ch(',');
+            // The ring holds kPlannerSize moves (written out: one call less).
+            static_assert(kPlannerSize == 16, "[OPT:I,16, follows kPlannerSize");
+            out::str(LL_PSTR("[VER:1.1h." LL_BUILD_DATE ":Low Level " LL_VERSION_STRING
+                             "]\r\n[OPT:I,16,"));
             out::u8(p.rx_capacity);
             // The curve extensions (docs/curves.md), as a message senders show as it is.
             out::line(LL_PSTR("]\r\n[MSG:G2.1/G3.1 ellipse IJ=centre PQ=semi-axes, G5 Bezier]"));
