@@ -171,8 +171,9 @@ uint8_t store(uint8_t n, const num::Decimal& value) {
         static const uint8_t kMax[kMilli] LL_PROGMEM = {255, 1, 255, kAxes - 1}; // by kind
         uint8_t max = flash_read_byte(&kMax[kind]);
         if (!num::to_uint(value, max, v)) return status::kInvalidStatement;
-        if (kind == kPulse && v < 3) return status::kStepPulseMin;
-        *f = static_cast<uint8_t>(v);
+        uint8_t b = static_cast<uint8_t>(v); // v <= max <= 255
+        if (kind == kPulse && b < 3) return status::kStepPulseMin;
+        *f = b;
     }
     save();
     return status::kOk;
