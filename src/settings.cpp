@@ -64,7 +64,8 @@ uint8_t* find(uint8_t n, uint8_t& kind) {
     for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
         uint8_t first = flash_read_byte(&row->number);
         uint8_t a = static_cast<uint8_t>(n - first);
-        if (a >= (first >= kFirstAxisNumber ? kAxes : 1)) continue;
+        uint8_t count = first >= kFirstAxisNumber ? kAxes : 1; // compared in 8 bits
+        if (a >= count) continue;
         kind = flash_read_byte(&row->kind);
         uint8_t stride = kind == kGroup ? 1 : sizeof(AxisSettings);
         return reinterpret_cast<uint8_t*>(&g_settings) + flash_read_byte(&row->offset) +
