@@ -35,7 +35,7 @@ enum : uint8_t {
 
 // What the protocol waits for before it reads the next line. Every wait keeps serving
 // real-time commands and motion::poll(); the line's `ok` comes when the wait ends. The first
-// three follow gcode::execute()'s retry codes, in their order.
+// three follow gcode::execute()'s retry codes, in their order; the next two gcode::Then's.
 enum class Wait : uint8_t {
     None,          // assembling a line
     WhenAccepting, // the planner is full: execute again when it has room
@@ -43,12 +43,15 @@ enum class Wait : uint8_t {
     DwellWhenIdle, // G4: start the dwell when motion is idle
     Dwell,         // G4: until `o.dwell_ms` (then a hal::millis() time)
     PauseWhenIdle, // M0: hold when motion is idle
-    Paused,        // M0: until cycle start ('~')
     EndWhenIdle,   // M2/M30: [MSG:Pgm End] when motion is idle
+    Paused,        // M0: until cycle start ('~')
 };
 static_assert(gcode::kRetryWhenIdle == gcode::kRetryWhenAccepting + 1 &&
                   gcode::kDwell == gcode::kRetryWhenAccepting + 2,
               "retry codes map to waits");
+static_assert(uint8_t(Wait::PauseWhenIdle) == uint8_t(gcode::Then::Pause) + 4 &&
+                  uint8_t(Wait::EndWhenIdle) == uint8_t(gcode::Then::ProgramEnd) + 4,
+              "M0 and M2/M30 map to waits");
 
 // Special result of a `$` command: answer ok, then soft-reset ($C off, $RST).
 constexpr uint8_t kOkThenReset = 0xFF;
@@ -61,7 +64,7 @@ struct Protocol {
     uint8_t lost_after; // after this many more bytes, the line in progress lost bytes
     uint8_t gflags;     // gcode::execute() flags for the pending line
     Wait wait;
-    uint8_t check;
+    uint8_t check;         // `$C` check mode: 0 or 1 (= gcode::kCheckMode)
     uint8_t wco_countdown; // status reports until WCO: is shown again
     // What gcode::execute() asked for (static: not a frame under which the move is planned);
     // o.dwell_ms: G4 ms, then (Wait::Dwell) hal::millis() at its end.
@@ -253,13 +256,13 @@ __attribute__((noinline)) uint8_t system_command() {
 
 void run_gcode() {
     gcode::Outcome& o = p.o;
-    uint8_t r = gcode::execute(
-        p.line, static_cast<uint8_t>(p.gflags | (p.check ? gcode::kCheckMode : 0)), o);
+    static_assert(gcode::kCheckMode == 1, "p.check (0 or 1) is the flag");
+    uint8_t r = gcode::execute(p.line, static_cast<uint8_t>(p.gflags | p.check), o);
     if (o.move) motion::push_line(*o.move); // planned here, not under execute()'s frame
     if (r >= gcode::kRetryWhenAccepting) {
         p.wait = static_cast<Wait>(r - gcode::kRetryWhenAccepting + uint8_t(Wait::WhenAccepting));
     } else if (r == kOk && o.then != gcode::Then::Nothing) {
-        p.wait = o.then == gcode::Then::Pause ? Wait::PauseWhenIdle : Wait::EndWhenIdle;
+        p.wait = static_cast<Wait>(uint8_t(o.then) + 4);
     } else {
         finish(r);
     }
