@@ -68,9 +68,12 @@ bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
 // The commanded position that matches a machine position in steps, mm x1000 (after an abort
 // the machine is between targets; the next move's direction is taken from here).
 void position_um(Motion& m, const int32_t steps[kAxes], int32_t um[kAxes]) {
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        uint32_t v = m.machine.um_q8_per_step[a].of(abs32(steps[a])) >> 8;
-        um[a] = static_cast<int32_t>(steps[a] < 0 ? 0u - v : v);
+    const Num* k = m.machine.um_q8_per_step;
+    for (uint8_t a = kAxes; a != 0; --a) {
+        int32_t s = *steps++;
+        uint32_t v = (k++)->of(abs32(s)) >> 8;
+        if (s < 0) v = 0u - v;
+        *um++ = static_cast<int32_t>(v);
     }
 }
 
