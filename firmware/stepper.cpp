@@ -314,7 +314,9 @@ void stepper_start() {
     uint8_t dir_b = board::dir_port_bits<Port::B>(levels);
     // The model sets the direction pins and starts counting at the same instant: start the
     // timer, then write the pins within a few cycles (the first event is a period later, the
-    // first interrupt a pulse width later).
+    // first interrupt a pulse width later). The masks are computed before interrupts go off
+    // (the compiler would otherwise schedule the shifts inside the critical section).
+    asm volatile("" : "+r"(dir_d), "+r"(dir_b));
     fw::IrqGuard g;
     TCCR1B = kTccr1bRunning;
     PORTD = static_cast<uint8_t>((PORTD & ~board::kDirMaskD) | dir_d);
