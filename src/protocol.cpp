@@ -109,16 +109,13 @@ void soft_reset() {
 
 __attribute__((noinline)) void report_status() {
     motion::State ms = motion::state();
-    // The state names, indexed below: alarm, check mode, M0 or held, then 5 - motion::State.
+    // The state names, indexed below: motion::State, then M0 (as held), check mode, alarm.
     static_assert(uint8_t(motion::State::Idle) == 0 && uint8_t(motion::State::Cycle) == 1 &&
                       uint8_t(motion::State::Holding) == 2 && uint8_t(motion::State::Held) == 3,
                   "state names follow motion::State");
-    uint8_t name = p.alarm                  ? 0
-                   : p.check                ? 1
-                   : p.wait == Wait::Paused ? 2
-                                            : static_cast<uint8_t>(5 - uint8_t(ms));
+    uint8_t name = p.alarm ? 5 : p.check ? 4 : p.wait == Wait::Paused ? 3 : uint8_t(ms);
     const char* s =
-        reinterpret_cast<const char*>(LL_PSTR("<Alarm\0<Check\0<Hold:0\0<Hold:1\0<Run\0<Idle"));
+        reinterpret_cast<const char*>(LL_PSTR("<Idle\0<Run\0<Hold:1\0<Hold:0\0<Check\0<Alarm"));
     while (name != 0) {
         if (flash_read_byte(s++) == 0) --name;
     }
