@@ -163,8 +163,9 @@ uint8_t blocks_free() {
 void poll() {
     Motion& m = mo();
     if (m.state == State::Idle && m.planner.empty() && drained()) {
-        if (m.enabled && g_settings.idle_delay_ms != 255 &&
-            static_cast<uint16_t>(hal::millis() - m.idle_since) >= g_settings.idle_delay_ms) {
+        uint8_t delay = g_settings.idle_delay_ms; // read once: millis() is a call
+        if (m.enabled && delay != 255 &&
+            static_cast<uint16_t>(hal::millis() - m.idle_since) >= delay) {
             enable(m, false);
         }
         return;
