@@ -324,13 +324,19 @@ void stepper_start() {
 }
 
 void stepper_stop() {
-    fw::IrqGuard g;
-    TCCR1B = kTccr1bStopped;
-    TIFR1 = _BV(OCF1A) | _BV(OCF1B);
-    GPIOR0 = 0;
-    // End a pulse in progress: step pins back to their idle level.
-    PORTD = static_cast<uint8_t>((PORTD & ~board::kStepMaskD) | s_idle_d);
-    PORTB = static_cast<uint8_t>((PORTB & ~board::kStepMaskB) | s_idle_b);
+    uint8_t idle_d = s_idle_d;
+    uint8_t idle_b = s_idle_b;
+    asm volatile("" : "+r"(idle_d), "+r"(idle_b)); // loaded before interrupts go off
+    {
+        fw::IrqGuard g;
+        TCCR1B = kTccr1bStopped;
+        TIFR1 = _BV(OCF1A) | _BV(OCF1B);
+        GPIOR0 = 0;
+        // End a pulse in progress: step pins back to their idle level.
+        PORTD = static_cast<uint8_t>((PORTD & ~board::kStepMaskD) | idle_d);
+        PORTB = static_cast<uint8_t>((PORTB & ~board::kStepMaskB) | idle_b);
+    }
+    // The timer is stopped and its flags clear: the step interrupt cannot run any more.
     g_exec.running = 0;
     g_exec.remaining = 0;
     g_exec.steps = 0;
