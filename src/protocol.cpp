@@ -193,7 +193,8 @@ __attribute__((noinline)) uint8_t system_command() {
         out::line(LL_PSTR("[HLP:$$ $# $G $I $x=val $C $X $RST=$ ~ ! ? ctrl-x]"));
         return kOk;
     }
-    bool one_letter = s[1] == 0;
+    char c1 = s[1];
+    bool one_letter = c1 == 0;
     if (c == '$' || c == 'G' || c == 'C' || c == 'X') {
         if (!one_letter) return kInvalidStatement;
         if (c == '$') {
@@ -234,7 +235,7 @@ __attribute__((noinline)) uint8_t system_command() {
     }
     if (c == 'R') { // $RST=$ settings, $RST=# G54, $RST=* both
         char what = s[4];
-        if (s[1] != 'S' || s[2] != 'T' || s[3] != '=' || s[5] != 0 ||
+        if (c1 != 'S' || s[2] != 'T' || s[3] != '=' || s[5] != 0 ||
             (what != '$' && what != '#' && what != '*')) {
             return kInvalidStatement;
         }
