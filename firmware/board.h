@@ -80,32 +80,53 @@ constexpr uint8_t dir_bit(uint8_t a, Port port) {
     return a < kAxes ? port_mask(kDirPins, kAxes, port, static_cast<uint8_t>(1u << a)) : 0;
 }
 
-/// Forces a compile-time value (a constexpr call in a run-time expression may be evaluated at
-/// run time, which would put the pin tables in RAM).
-template <uint8_t V>
-struct Const {
-    static constexpr uint8_t value = V;
-};
+/// The axes (bits) whose pin in `pins` sits on `port`.
+constexpr uint8_t axes_on(const PinDesc* pins, Port port) {
+    uint8_t m = 0;
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        if (pins[a].port == port) m = static_cast<uint8_t>(m | (1u << a));
+    }
+    return m;
+}
+/// The s such that the pin of every axis a on `port` is port bit a + s (the port bits are then
+/// the axis bits shifted, a few instructions); -1 when there is none.
+constexpr int shift_on(const PinDesc* pins, Port port) {
+    int s = -1;
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        if (pins[a].port != port) continue;
+        int b = 0;
+        while (b < 8 && pins[a].mask != (1u << b)) ++b;
+        int d = b - a;
+        if (d < 0 || (s >= 0 && s != d)) return -1;
+        s = d;
+    }
+    return s < 0 ? 0 : s;
+}
 
-/// Port bits of the step (or direction) pins of the axes in `axes`, at run time, from constant
-/// masks only (the pin tables above never reach RAM or the interrupt).
+/// Port bits on P of the axes in `axes`, for the pins `pins`: a shift when the pins are in axis
+/// order on consecutive bits, else one test per axis, from constant masks only (template
+/// arguments: the pin tables never reach RAM or the interrupt).
+template <Port P, uint8_t B0, uint8_t B1, uint8_t B2, uint8_t B3, uint8_t Axes, int Shift>
+inline uint8_t port_bits(uint8_t axes) {
+    if (Shift >= 0) return static_cast<uint8_t>((axes & Axes) << (Shift < 0 ? 0 : Shift));
+    uint8_t m = 0;
+    if (axes & 1u) m = static_cast<uint8_t>(m | B0);
+    if (axes & 2u) m = static_cast<uint8_t>(m | B1);
+    if (axes & 4u) m = static_cast<uint8_t>(m | B2);
+    if (axes & 8u) m = static_cast<uint8_t>(m | B3);
+    return m;
+}
+
+/// Port bits of the step (or direction) pins of the axes in `axes`, at run time.
 template <Port P>
 inline uint8_t step_port_bits(uint8_t axes) {
-    uint8_t m = 0;
-    if (axes & 1u) m = static_cast<uint8_t>(m | Const<step_bit(0, P)>::value);
-    if (axes & 2u) m = static_cast<uint8_t>(m | Const<step_bit(1, P)>::value);
-    if (axes & 4u) m = static_cast<uint8_t>(m | Const<step_bit(2, P)>::value);
-    if (axes & 8u) m = static_cast<uint8_t>(m | Const<step_bit(3, P)>::value);
-    return m;
+    return port_bits<P, step_bit(0, P), step_bit(1, P), step_bit(2, P), step_bit(3, P),
+                     axes_on(kStepPins, P), shift_on(kStepPins, P)>(axes);
 }
 template <Port P>
 inline uint8_t dir_port_bits(uint8_t axes) {
-    uint8_t m = 0;
-    if (axes & 1u) m = static_cast<uint8_t>(m | Const<dir_bit(0, P)>::value);
-    if (axes & 2u) m = static_cast<uint8_t>(m | Const<dir_bit(1, P)>::value);
-    if (axes & 4u) m = static_cast<uint8_t>(m | Const<dir_bit(2, P)>::value);
-    if (axes & 8u) m = static_cast<uint8_t>(m | Const<dir_bit(3, P)>::value);
-    return m;
+    return port_bits<P, dir_bit(0, P), dir_bit(1, P), dir_bit(2, P), dir_bit(3, P),
+                     axes_on(kDirPins, P), shift_on(kDirPins, P)>(axes);
 }
 static_assert(kBoardAxes == 4, "step_port_bits/dir_port_bits and the interrupt cover 4 axes");
 

@@ -1,6 +1,6 @@
 // Millisecond clock: Timer2 in CTC mode, prescaler 64, OCR2A = 249 -> one interrupt per ms.
 // The compare flag clears itself when the vector runs, so the handler re-enables interrupts
-// first (ISR_NOBLOCK): it can delay a step edge by its 4-cycle entry, the jmp and the sei only.
+// first: it can delay a step edge by its 4-cycle entry, the jmp and the sei only.
 #include <avr/interrupt.h>
 #include <avr/io.h>
 
@@ -13,8 +13,35 @@ volatile uint32_t s_millis; // ms since clock_init(), wraps after 49.7 days
 } // namespace
 } // namespace ll
 
-ISR(TIMER2_COMPA_vect, ISR_NOBLOCK) {
-    ll::s_millis = ll::s_millis + 1;
+// s_millis + 1, a byte at a time, stopping at the first byte that does not wrap (C's version
+// saves r0, r1 and four registers for a 32-bit add).
+ISR(TIMER2_COMPA_vect, ISR_NAKED) {
+    asm volatile("sei\n\t"
+                 "push r24\n\t"
+                 "in   r24, __SREG__\n\t"
+                 "push r24\n\t"
+                 "lds  r24, %[ms]+0\n\t"
+                 "inc  r24\n\t"
+                 "sts  %[ms]+0, r24\n\t"
+                 "brne 1f\n\t"
+                 "lds  r24, %[ms]+1\n\t"
+                 "inc  r24\n\t"
+                 "sts  %[ms]+1, r24\n\t"
+                 "brne 1f\n\t"
+                 "lds  r24, %[ms]+2\n\t"
+                 "inc  r24\n\t"
+                 "sts  %[ms]+2, r24\n\t"
+                 "brne 1f\n\t"
+                 "lds  r24, %[ms]+3\n\t"
+                 "inc  r24\n\t"
+                 "sts  %[ms]+3, r24\n\t"
+                 "1:\n\t"
+                 "pop  r24\n\t"
+                 "out  __SREG__, r24\n\t"
+                 "pop  r24\n\t"
+                 "reti\n\t"
+                 :
+                 : [ms] "i"(&ll::s_millis));
 }
 
 namespace ll {
@@ -34,13 +61,9 @@ void clock_init() {
 namespace hal {
 
 uint32_t millis() {
-    // Lock-free: read until two reads agree (the interrupt changes it once per ms).
-    uint32_t a = s_millis;
-    for (;;) {
-        uint32_t b = s_millis;
-        if (a == b) return a;
-        a = b;
-    }
+    // Interrupts off for the four loads (cli to restore: 10 cycles).
+    fw::IrqGuard g;
+    return s_millis;
 }
 
 } // namespace hal

@@ -43,15 +43,14 @@ volatile uint8_t s_tx_head;   // consumer: transmit handler (or serial_put when 
 volatile uint8_t s_tx_tail;   // producer: main loop
 volatile uint8_t s_tx_active; // a "transmit complete" interrupt is still to come
 
-void rx_push(uint8_t byte) {
-    if (rt::filter(byte)) return;
+// Queues a received byte; false when the ring is full (the byte is lost).
+bool rx_push(uint8_t byte) {
+    if (rt::filter(byte)) return true;
     uint8_t t = s_rx_tail;
-    if (static_cast<uint8_t>(t - s_rx_head) >= kRxSize) {
-        s_rx_overflow = 1;
-        return;
-    }
+    if (static_cast<uint8_t>(t - s_rx_head) >= kRxSize) return false;
     s_rx_buf[t & (kRxSize - 1)] = byte;
     s_rx_tail = static_cast<uint8_t>(t + 1);
+    return true;
 }
 
 } // namespace
@@ -65,8 +64,8 @@ void __vector_rx_drain() {
     do {
         uint8_t status = UCSR0A;
         uint8_t byte = UDR0;
-        if (status & _BV(DOR0)) s_rx_overflow = 1; // the hardware lost a byte before this one
-        rx_push(byte);
+        // DOR0: the hardware lost a byte before this one.
+        if (!rx_push(byte) || (status & _BV(DOR0))) s_rx_overflow = 1;
     } while (UCSR0A & _BV(RXC0));
     UCSR0B = kUcsr0bRun; // a byte that arrived meanwhile raises the interrupt again at once
 }
@@ -143,7 +142,8 @@ void serial_put(uint8_t byte) {
         // Full, so a transmission is under way: the interrupt frees a slot within two frames.
     }
     s_tx_buf[t & (kTxSize - 1)] = byte;
-    s_tx_tail = static_cast<uint8_t>(t + 1);
+    t = static_cast<uint8_t>(t + 1);
+    s_tx_tail = t;
     uint8_t was_active;
     {
         fw::IrqGuard g; // test-and-set, 4 cycles
@@ -152,10 +152,10 @@ void serial_put(uint8_t byte) {
     }
     if (!was_active) {
         // The transmitter was idle and no completion is pending, so the interrupt cannot run
-        // before this byte has left: take it from the ring here.
-        uint8_t h = s_tx_head;
-        UDR0 = s_tx_buf[h & (kTxSize - 1)];
-        s_tx_head = static_cast<uint8_t>(h + 1);
+        // before this byte has left: take it from the ring here. The ring was empty (the
+        // interrupt found it so before it cleared s_tx_active), so it is this byte.
+        UDR0 = byte;
+        s_tx_head = t;
     }
 }
 

@@ -254,7 +254,11 @@ void stepper_init() {
     TCCR1A = 0;
     TIMSK1 = _BV(OCIE1A) | _BV(OCIE1B); // the timer only runs while there are runs
     GPIOR0 = 0;
-    hal::stepper_configure(hal::StepperConfig{160, 0, 0, 0});
+    // What stepper_configure(StepperConfig{160, 0, 0, 0}) would do: 10 us pulses, nothing
+    // inverted. The masks and step pins are already 0 (static RAM, board_init()).
+    constexpr uint16_t kBootPulse = 160;
+    s_ocr1b = static_cast<uint16_t>(st::effective_pulse(kBootPulse) - 1 + st::kPulseGuard);
+    s_min_period = st::min_period(kBootPulse);
     hal::stepper_enable(false);
 }
 
@@ -266,13 +270,15 @@ void stepper_configure(const StepperConfig& cfg) {
     uint16_t pulse = st::effective_pulse(cfg.pulse_cycles);
     s_ocr1b = static_cast<uint16_t>(pulse - 1 + st::kPulseGuard);
     s_min_period = st::min_period(cfg.pulse_cycles);
-    s_idle_d = board::step_port_bits<Port::D>(cfg.step_invert);
-    s_idle_b = board::step_port_bits<Port::B>(cfg.step_invert);
+    uint8_t idle_d = board::step_port_bits<Port::D>(cfg.step_invert);
+    uint8_t idle_b = board::step_port_bits<Port::B>(cfg.step_invert);
+    s_idle_d = idle_d;
+    s_idle_b = idle_b;
     s_dir_invert = cfg.dir_invert;
     s_enable_invert = cfg.enable_invert ? 1 : 0;
     fw::IrqGuard g;
-    PORTD = static_cast<uint8_t>((PORTD & ~board::kStepMaskD) | s_idle_d);
-    PORTB = static_cast<uint8_t>((PORTB & ~board::kStepMaskB) | s_idle_b);
+    PORTD = static_cast<uint8_t>((PORTD & ~board::kStepMaskD) | idle_d);
+    PORTB = static_cast<uint8_t>((PORTB & ~board::kStepMaskB) | idle_b);
 }
 
 void stepper_start() {
@@ -280,8 +286,11 @@ void stepper_start() {
     const Run& r = g_runs.front();
     uint8_t steps = r.steps;
     uint8_t dirs = r.dirs;
-    uint16_t period = r.period < s_min_period ? s_min_period : r.period;
-    g_exec.remaining = r.count;
+    uint8_t count = r.count; // read before the volatile guard: r is not looked up again
+    uint16_t period = r.period;
+    uint16_t min_period = s_min_period;
+    if (period < min_period) period = min_period;
+    g_exec.remaining = count;
     g_exec.steps = steps;
     g_exec.dirs = dirs;
     g_exec.starved = 0;
@@ -305,7 +314,9 @@ void stepper_start() {
     uint8_t dir_b = board::dir_port_bits<Port::B>(levels);
     // The model sets the direction pins and starts counting at the same instant: start the
     // timer, then write the pins within a few cycles (the first event is a period later, the
-    // first interrupt a pulse width later).
+    // first interrupt a pulse width later). The masks are computed before interrupts go off
+    // (the compiler would otherwise schedule the shifts inside the critical section).
+    asm volatile("" : "+r"(dir_d), "+r"(dir_b));
     fw::IrqGuard g;
     TCCR1B = kTccr1bRunning;
     PORTD = static_cast<uint8_t>((PORTD & ~board::kDirMaskD) | dir_d);
@@ -313,13 +324,19 @@ void stepper_start() {
 }
 
 void stepper_stop() {
-    fw::IrqGuard g;
-    TCCR1B = kTccr1bStopped;
-    TIFR1 = _BV(OCF1A) | _BV(OCF1B);
-    GPIOR0 = 0;
-    // End a pulse in progress: step pins back to their idle level.
-    PORTD = static_cast<uint8_t>((PORTD & ~board::kStepMaskD) | s_idle_d);
-    PORTB = static_cast<uint8_t>((PORTB & ~board::kStepMaskB) | s_idle_b);
+    uint8_t idle_d = s_idle_d;
+    uint8_t idle_b = s_idle_b;
+    asm volatile("" : "+r"(idle_d), "+r"(idle_b)); // loaded before interrupts go off
+    {
+        fw::IrqGuard g;
+        TCCR1B = kTccr1bStopped;
+        TIFR1 = _BV(OCF1A) | _BV(OCF1B);
+        GPIOR0 = 0;
+        // End a pulse in progress: step pins back to their idle level.
+        PORTD = static_cast<uint8_t>((PORTD & ~board::kStepMaskD) | idle_d);
+        PORTB = static_cast<uint8_t>((PORTB & ~board::kStepMaskB) | idle_b);
+    }
+    // The timer is stopped and its flags clear: the step interrupt cannot run any more.
     g_exec.running = 0;
     g_exec.remaining = 0;
     g_exec.steps = 0;

@@ -1,6 +1,8 @@
 // motion.h on top of the planner, the step generator and the run queue.
 #include "lowlevel/motion.h"
 
+#include <string.h>
+
 #include "lowlevel/hal.h"
 #include "lowlevel/planner.h"
 #include "lowlevel/run_queue.h"
@@ -66,16 +68,34 @@ bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
 // The commanded position that matches a machine position in steps, mm x1000 (after an abort
 // the machine is between targets; the next move's direction is taken from here).
 void position_um(Motion& m, const int32_t steps[kAxes], int32_t um[kAxes]) {
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        uint32_t v = m.machine.um_q8_per_step[a].of(abs32(steps[a])) >> 8;
-        um[a] = static_cast<int32_t>(steps[a] < 0 ? 0u - v : v);
+    const Num* k = m.machine.um_q8_per_step;
+    for (uint8_t a = kAxes; a != 0; --a) {
+        int32_t s = *steps++;
+        uint32_t v = (k++)->of(abs32(s)) >> 8;
+        if (s < 0) v = 0u - v;
+        *um++ = static_cast<int32_t>(v);
     }
+}
+
+// Where the machine is while the planner is reset (abort(), settings_changed()), in the scratch
+// RAM: those run outside poll() and gcode::execute() (motion.h), and their frames shrink.
+struct Here {
+    int32_t steps[kAxes];
+    hal::StepperConfig cfg; // settings_changed()
+};
+inline Here& here_scratch() {
+    return scratch<Here>();
 }
 
 __attribute__((noinline)) void reset_planner(Motion& m, const int32_t here[kAxes]) {
     int32_t um[kAxes];
     position_um(m, here, um);
     m.planner.reset(here, um);
+}
+
+// Nothing queued for the step interrupt and nothing running.
+__attribute__((noinline)) bool drained() {
+    return g_runs.empty() && !g_exec.running;
 }
 
 __attribute__((noinline)) void enable(Motion& m, bool on) {
@@ -107,7 +127,8 @@ void restart(Motion& m, const int32_t here[kAxes]) {
 alignas(alignof(void*)) uint8_t g_scratch[kScratchBytes]; // 1 on the AVR, 8 on the host
 
 void init() {
-    int32_t zero[kAxes] = {};
+    int32_t* zero = here_scratch().steps;
+    memset(zero, 0, sizeof(Here::steps));
     restart(mo(), zero);
     mo().enabled = false;
     g_starvations = 0;
@@ -141,9 +162,10 @@ uint8_t blocks_free() {
 
 void poll() {
     Motion& m = mo();
-    if (m.state == State::Idle && m.planner.empty() && g_runs.empty() && !g_exec.running) {
-        if (m.enabled && g_settings.idle_delay_ms != 255 &&
-            static_cast<uint16_t>(hal::millis() - m.idle_since) >= g_settings.idle_delay_ms) {
+    if (m.state == State::Idle && m.planner.empty() && drained()) {
+        uint8_t delay = g_settings.idle_delay_ms; // read once: millis() is a call
+        if (m.enabled && delay != 255 &&
+            static_cast<uint16_t>(hal::millis() - m.idle_since) >= delay) {
             enable(m, false);
         }
         return;
@@ -160,7 +182,7 @@ void poll() {
             hal::stepper_start();
         }
     }
-    if (!g_runs.empty() || g_exec.running) return; // not drained
+    if (!drained()) return;
     if (m.state == State::Holding) {
         if (m.gen.stopped() || !pending) m.state = State::Held;
     } else if (m.state == State::Cycle && !pending) {
@@ -207,7 +229,7 @@ void cycle_start() {
 
 bool abort() {
     bool moving = g_exec.running != 0;
-    int32_t here[kAxes];
+    int32_t* here = here_scratch().steps;
     position(here);
     restart(mo(), here);
     return moving;
@@ -228,7 +250,11 @@ void position(int32_t steps[kAxes]) {
     // between the consumer and the producer.
     for (;;) {
         for (uint8_t a = 0; a < kAxes; ++a, s >>= 1, d >>= 1) {
-            if (s & 1) steps[a] += (d & 1) ? n : -static_cast<int16_t>(n);
+            if (s & 1) {
+                int16_t dn = n;
+                if (!(d & 1)) dn = static_cast<int16_t>(-dn);
+                steps[a] += dn;
+            }
         }
         if (i == g_runs.tail) return;
         const Run& r = g_runs.buf[i];
@@ -250,13 +276,13 @@ void settings_changed() {
     machine_build(m.machine, g_settings);
     m.planner.configure(&m.machine);
     m.gen.configure(&m.machine.lengths, m.machine.min_period, m.machine.um_q8_per_step);
-    hal::StepperConfig cfg;
+    hal::StepperConfig& cfg = here_scratch().cfg;
     cfg.pulse_cycles = static_cast<uint16_t>(g_settings.pulse_us * (kCpuHz / 1000000));
     cfg.step_invert = g_settings.step_invert;
     cfg.dir_invert = g_settings.dir_invert;
     cfg.enable_invert = g_settings.enable_invert;
     hal::stepper_configure(cfg);
-    int32_t here[kAxes];
+    int32_t* here = here_scratch().steps;
     position(here);
     reset_planner(m, here);
     if (g_settings.idle_delay_ms == 255) enable(m, true);

@@ -35,7 +35,7 @@ enum : uint8_t {
 
 // What the protocol waits for before it reads the next line. Every wait keeps serving
 // real-time commands and motion::poll(); the line's `ok` comes when the wait ends. The first
-// three follow gcode::execute()'s retry codes, in their order.
+// three follow gcode::execute()'s retry codes, in their order; the next two gcode::Then's.
 enum class Wait : uint8_t {
     None,          // assembling a line
     WhenAccepting, // the planner is full: execute again when it has room
@@ -43,12 +43,15 @@ enum class Wait : uint8_t {
     DwellWhenIdle, // G4: start the dwell when motion is idle
     Dwell,         // G4: until `o.dwell_ms` (then a hal::millis() time)
     PauseWhenIdle, // M0: hold when motion is idle
-    Paused,        // M0: until cycle start ('~')
     EndWhenIdle,   // M2/M30: [MSG:Pgm End] when motion is idle
+    Paused,        // M0: until cycle start ('~')
 };
 static_assert(gcode::kRetryWhenIdle == gcode::kRetryWhenAccepting + 1 &&
                   gcode::kDwell == gcode::kRetryWhenAccepting + 2,
               "retry codes map to waits");
+static_assert(uint8_t(Wait::PauseWhenIdle) == uint8_t(gcode::Then::Pause) + 4 &&
+                  uint8_t(Wait::EndWhenIdle) == uint8_t(gcode::Then::ProgramEnd) + 4,
+              "M0 and M2/M30 map to waits");
 
 // Special result of a `$` command: answer ok, then soft-reset ($C off, $RST).
 constexpr uint8_t kOkThenReset = 0xFF;
@@ -61,7 +64,7 @@ struct Protocol {
     uint8_t lost_after; // after this many more bytes, the line in progress lost bytes
     uint8_t gflags;     // gcode::execute() flags for the pending line
     Wait wait;
-    uint8_t check;
+    uint8_t check;         // `$C` check mode: 0 or 1 (= gcode::kCheckMode)
     uint8_t wco_countdown; // status reports until WCO: is shown again
     // What gcode::execute() asked for (static: not a frame under which the move is planned);
     // o.dwell_ms: G4 ms, then (Wait::Dwell) hal::millis() at its end.
@@ -106,21 +109,24 @@ void soft_reset() {
 
 __attribute__((noinline)) void report_status() {
     motion::State ms = motion::state();
-    // The state names, indexed below: alarm, check mode, M0 or held, then 5 - motion::State.
+    // The state names, indexed below: motion::State, then M0 (as held), check mode, alarm.
     static_assert(uint8_t(motion::State::Idle) == 0 && uint8_t(motion::State::Cycle) == 1 &&
                       uint8_t(motion::State::Holding) == 2 && uint8_t(motion::State::Held) == 3,
                   "state names follow motion::State");
-    uint8_t name = p.alarm                  ? 0
-                   : p.check                ? 1
-                   : p.wait == Wait::Paused ? 2
-                                            : static_cast<uint8_t>(5 - uint8_t(ms));
+    uint8_t name = p.alarm ? 5 : p.check ? 4 : p.wait == Wait::Paused ? 3 : uint8_t(ms);
     const char* s =
-        reinterpret_cast<const char*>(LL_PSTR("<Alarm\0<Check\0<Hold:0\0<Hold:1\0<Run\0<Idle"));
+        reinterpret_cast<const char*>(LL_PSTR("<Idle\0<Run\0<Hold:1\0<Hold:0\0<Check\0<Alarm"));
     while (name != 0) {
         if (flash_read_byte(s++) == 0) --name;
     }
     out::str(reinterpret_cast<const FlashChar*>(s));
-    int32_t pos[kAxes], wco[kAxes];
+    // In the motion side's scratch RAM (motion.h): no frame to build, 32 B less stack.
+    struct Coords {
+        int32_t pos[kAxes], wco[kAxes];
+    };
+    Coords& c = motion::scratch<Coords>();
+    int32_t* pos = c.pos;
+    int32_t(&wco)[kAxes] = c.wco;
     motion::position(pos);
     gcode::steps_to_um(pos, pos);
     gcode::work_offset(wco);
@@ -158,16 +164,20 @@ __attribute__((noinline)) void report_status() {
 
 // `$N=value`.
 uint8_t store_setting() {
-    num::Decimal n, v;
-    const char* s = num::parse(p.line + 1, n);
+    // In the motion side's scratch RAM (motion.h), as the status report's coordinates: no frame.
+    struct Words {
+        num::Decimal n, v;
+        uint32_t number;
+    };
+    Words& w = motion::scratch<Words>();
+    const char* s = num::parse(p.line + 1, w.n);
     if (s == nullptr) return kBadNumberFormat;
     if (*s++ != '=') return kInvalidStatement;
-    uint32_t number;
-    if (!num::to_uint(n, 255u, number)) return kInvalidStatement;
-    s = num::parse(s, v);
+    if (!num::to_uint(w.n, 255u, w.number)) return kInvalidStatement;
+    s = num::parse(s, w.v);
     if (s == nullptr) return kBadNumberFormat;
     if (*s != 0) return kInvalidStatement;
-    uint8_t r = settings::store(static_cast<uint8_t>(number), v);
+    uint8_t r = settings::store(static_cast<uint8_t>(w.number), w.v);
     if (r == kOk) {
         motion::settings_changed();
         gcode::settings_changed();
@@ -183,7 +193,8 @@ __attribute__((noinline)) uint8_t system_command() {
         out::line(LL_PSTR("[HLP:$$ $# $G $I $x=val $C $X $RST=$ ~ ! ? ctrl-x]"));
         return kOk;
     }
-    bool one_letter = s[1] == 0;
+    char c1 = s[1];
+    bool one_letter = c1 == 0;
     if (c == '$' || c == 'G' || c == 'C' || c == 'X') {
         if (!one_letter) return kInvalidStatement;
         if (c == '$') {
@@ -212,10 +223,10 @@ __attribute__((noinline)) uint8_t system_command() {
         if (c == '#') {
             gcode::report_offsets();
         } else {
-            out::str(
-                LL_PSTR("[VER:1.1h." LL_BUILD_DATE ":Low Level " LL_VERSION_STRING "]\r\n[OPT:I,"));
-            out::u8(kPlannerSize); // the ring holds kPlannerSize moves
-            out::ch(',');
+            // The ring holds kPlannerSize moves (written out: one call less).
+            static_assert(kPlannerSize == 16, "[OPT:I,16, follows kPlannerSize");
+            out::str(LL_PSTR("[VER:1.1h." LL_BUILD_DATE ":Low Level " LL_VERSION_STRING
+                             "]\r\n[OPT:I,16,"));
             out::u8(p.rx_capacity);
             // The curve extensions (docs/curves.md), as a message senders show as it is.
             out::line(LL_PSTR("]\r\n[MSG:G2.1/G3.1 ellipse IJ=centre PQ=semi-axes, G5 Bezier]"));
@@ -224,7 +235,7 @@ __attribute__((noinline)) uint8_t system_command() {
     }
     if (c == 'R') { // $RST=$ settings, $RST=# G54, $RST=* both
         char what = s[4];
-        if (s[1] != 'S' || s[2] != 'T' || s[3] != '=' || s[5] != 0 ||
+        if (c1 != 'S' || s[2] != 'T' || s[3] != '=' || s[5] != 0 ||
             (what != '$' && what != '#' && what != '*')) {
             return kInvalidStatement;
         }
@@ -232,8 +243,7 @@ __attribute__((noinline)) uint8_t system_command() {
             settings::restore_defaults(); // also zeroes G54
             motion::settings_changed();
         } else {
-            int32_t zero[kAxes] = {};
-            settings::save_coord(zero);
+            settings::clear_coord();
         }
         out::msg(LL_PSTR("Restoring defaults"));
         return kOkThenReset;
@@ -244,13 +254,13 @@ __attribute__((noinline)) uint8_t system_command() {
 
 void run_gcode() {
     gcode::Outcome& o = p.o;
-    uint8_t r = gcode::execute(
-        p.line, static_cast<uint8_t>(p.gflags | (p.check ? gcode::kCheckMode : 0)), o);
+    static_assert(gcode::kCheckMode == 1, "p.check (0 or 1) is the flag");
+    uint8_t r = gcode::execute(p.line, static_cast<uint8_t>(p.gflags | p.check), o);
     if (o.move) motion::push_line(*o.move); // planned here, not under execute()'s frame
     if (r >= gcode::kRetryWhenAccepting) {
         p.wait = static_cast<Wait>(r - gcode::kRetryWhenAccepting + uint8_t(Wait::WhenAccepting));
     } else if (r == kOk && o.then != gcode::Then::Nothing) {
-        p.wait = o.then == gcode::Then::Pause ? Wait::PauseWhenIdle : Wait::EndWhenIdle;
+        p.wait = static_cast<Wait>(uint8_t(o.then) + 4);
     } else {
         finish(r);
     }
@@ -293,8 +303,9 @@ void read_line() {
             p.lost_after = static_cast<uint8_t>(p.rx_capacity - free);
             if (p.lost_after == 0) p.flags |= kLost;
         }
-        uint8_t c;
-        if (!hal::serial_get(c)) return;
+        uint8_t got;
+        if (!hal::serial_get(got)) return;
+        uint8_t c = got;
         bool end = false;
         uint8_t f = p.flags;
         if (c == '\n' || c == '\r') {

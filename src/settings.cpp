@@ -59,34 +59,43 @@ const Row kRows[] LL_PROGMEM = {
 #undef LL_ROW
 constexpr uint8_t kRowCount = sizeof(kRows) / sizeof(kRows[0]);
 
-// The field of `row` for axis `a` (0 for the machine-wide rows).
-uint8_t* field(const Row* row, uint8_t kind, uint8_t a) {
-    uint8_t stride = kind == kGroup ? 1 : sizeof(AxisSettings);
-    return reinterpret_cast<uint8_t*>(&g_settings) + flash_read_byte(&row->offset) +
-           static_cast<uint8_t>(a * stride);
+// The field that holds `$n` and its kind; nullptr when no row has that number.
+uint8_t* find(uint8_t n, uint8_t& kind) {
+    for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
+        uint8_t first = flash_read_byte(&row->number);
+        uint8_t a = static_cast<uint8_t>(n - first);
+        uint8_t count = first >= kFirstAxisNumber ? kAxes : 1; // compared in 8 bits
+        if (a >= count) continue;
+        kind = flash_read_byte(&row->kind);
+        uint8_t stride = kind == kGroup ? 1 : sizeof(AxisSettings);
+        return reinterpret_cast<uint8_t*>(&g_settings) + flash_read_byte(&row->offset) +
+               static_cast<uint8_t>(a * stride);
+    }
+    return nullptr;
 }
 
 // Fletcher-style 16-bit check over the record (two running 8-bit sums), computed while it is
 // read or written: catches changed, swapped and zeroed bytes, and a blank (all 0xFF) record
 // never matches its own check. Returns true when a read record matches its check.
+// Writes v at addr and returns it, or (write false) returns the byte at addr.
+__attribute__((noinline)) uint8_t transfer(uint16_t addr, uint8_t v, bool write) {
+    if (!write) return hal::eeprom_read(addr);
+    hal::eeprom_write(addr, v);
+    return v;
+}
+
 bool record(uint16_t addr, void* data, uint8_t n, bool write) {
     uint8_t* p = static_cast<uint8_t*>(data);
     uint8_t a = 0x5A, b = 0xA5;
     for (uint8_t i = 0; i < n; ++i, ++addr) {
-        if (write) {
-            hal::eeprom_write(addr, p[i]);
-        } else {
-            p[i] = hal::eeprom_read(addr);
-        }
-        a = static_cast<uint8_t>(a + p[i]);
+        uint8_t v = transfer(addr, p[i], write);
+        p[i] = v; // unchanged when writing
+        a = static_cast<uint8_t>(a + v);
         b = static_cast<uint8_t>(b + a);
     }
-    if (write) {
-        hal::eeprom_write(addr, a);
-        hal::eeprom_write(static_cast<uint16_t>(addr + 1), b);
-        return true;
-    }
-    return hal::eeprom_read(addr) == a && hal::eeprom_read(static_cast<uint16_t>(addr + 1)) == b;
+    // Writing, both compare equal (and both bytes are written: no short cut).
+    return transfer(addr, a, write) == a &&
+           transfer(static_cast<uint16_t>(addr + 1), b, write) == b;
 }
 
 // GRBL 1.1h's generic machine, $10=3 and the speed groups X Y Z -> 0, A B C -> 1.
@@ -118,6 +127,10 @@ void save() {
 void restore_defaults() {
     flash_copy(&g_settings, &kDefaults, sizeof(Settings));
     save();
+    clear_coord();
+}
+
+void clear_coord() {
     int32_t zero[kAxes] = {};
     save_coord(zero);
 }
@@ -144,53 +157,49 @@ void save_coord(const int32_t (&um)[kAxes]) {
 
 uint8_t store(uint8_t n, const num::Decimal& value) {
     if (value.negative()) return status::kNegativeValue;
-    for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
-        uint8_t first = flash_read_byte(&row->number);
-        uint8_t a = static_cast<uint8_t>(n - first);
-        if (a >= (first >= kFirstAxisNumber ? kAxes : 1)) continue;
-        uint8_t kind = flash_read_byte(&row->kind);
-        uint8_t* f = field(row, kind, a);
-        if (kind >= kMilli) {
-            int32_t milli;
-            if (!num::to_milli(value, milli)) return status::kInvalidStatement;
-            if (milli == 0 && kind == kMilliPos) return status::kNegativeValue;
-            memcpy(f, &milli, sizeof(milli));
-        } else {
-            uint32_t v;
-            static_assert(kByte == 0 && kBool == 1 && kPulse == 2 && kGroup == 3 && kMilli == 4,
-                          "kMax follows the kinds");
-            static const uint8_t kMax[kMilli] LL_PROGMEM = {255, 1, 255, kAxes - 1}; // by kind
-            uint8_t max = flash_read_byte(&kMax[kind]);
-            if (!num::to_uint(value, max, v)) return status::kInvalidStatement;
-            if (kind == kPulse && v < 3) return status::kStepPulseMin;
-            *f = static_cast<uint8_t>(v);
-        }
-        save();
-        return status::kOk;
+    uint8_t kind;
+    uint8_t* f = find(n, kind);
+    if (f == nullptr) return status::kInvalidStatement;
+    if (kind >= kMilli) {
+        int32_t milli;
+        if (!num::to_milli(value, milli)) return status::kInvalidStatement;
+        if (milli == 0 && kind == kMilliPos) return status::kNegativeValue;
+        memcpy(f, &milli, sizeof(milli));
+    } else {
+        uint32_t v;
+        static_assert(kByte == 0 && kBool == 1 && kPulse == 2 && kGroup == 3 && kMilli == 4,
+                      "kMax follows the kinds");
+        static const uint8_t kMax[kMilli] LL_PROGMEM = {255, 1, 255, kAxes - 1}; // by kind
+        uint8_t max = flash_read_byte(&kMax[kind]);
+        if (!num::to_uint(value, max, v)) return status::kInvalidStatement;
+        uint8_t b = static_cast<uint8_t>(v); // v <= max <= 255
+        if (kind == kPulse && b < 3) return status::kStepPulseMin;
+        *f = b;
     }
-    return status::kInvalidStatement;
+    save();
+    return status::kOk;
 }
 
 void report() {
-    for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
-        uint8_t first = flash_read_byte(&row->number);
-        uint8_t kind = flash_read_byte(&row->kind);
-        uint8_t count = first >= kFirstAxisNumber ? kAxes : 1;
-        for (uint8_t a = 0; a < count; ++a) {
-            const uint8_t* f = field(row, kind, a);
-            out::ch('$');
-            out::u8(static_cast<uint8_t>(first + a));
-            out::ch('=');
-            if (kind >= kMilli) {
-                int32_t milli;
-                memcpy(&milli, f, sizeof(milli));
-                out::fixed(milli, 3);
-            } else {
-                out::u8(*f);
-            }
-            out::eol();
+    // Every number in turn, looked up as `$N=` would be: the rows are in increasing order, so
+    // this prints them in `$$` order without a second walk over the table.
+    uint8_t n = 0;
+    do {
+        uint8_t kind;
+        const uint8_t* f = find(n, kind);
+        if (f == nullptr) continue;
+        out::ch('$');
+        out::u8(n);
+        out::ch('=');
+        if (kind >= kMilli) {
+            int32_t milli;
+            memcpy(&milli, f, sizeof(milli));
+            out::fixed(milli, 3);
+        } else {
+            out::u8(*f);
         }
-    }
+        out::eol();
+    } while (++n != 0);
 }
 
 } // namespace settings

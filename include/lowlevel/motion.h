@@ -23,7 +23,10 @@ struct LineRequest {
 /// generator. Outside poll() it is lent to the G-code layer, which keeps there its work block
 /// (gcode.cpp), live from gcode::execute() until push_line() has queued the move: push_line()
 /// only polls once the move is in the planner, and execute() never polls. Sharing it saves RAM
-/// on the deepest stack (the move handed over was a local of poll()).
+/// on the deepest stack (the move handed over was a local of poll()). The status report
+/// (protocol.cpp) and the `$` commands, which run neither inside poll() nor inside execute() and
+/// poll nothing, keep their coordinates and numbers there too, as do init(), abort() and
+/// settings_changed().
 // The size of the G-code work block on the AVR (gcode.cpp checks it), generous on the host.
 constexpr uint16_t kScratchBytes =
     sizeof(void*) == 2 ? 92 + 16 * kAxes + (kAxes > 5 ? 2 : 0) : 128 + 32 * kAxes;

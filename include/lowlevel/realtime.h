@@ -22,21 +22,15 @@ extern volatile uint8_t g_pending;
 /// 0x87 debug, 0x90-0x9D overrides, 0xA0-0xA1 accessories) are consumed and ignored: a sender
 /// may send them at any time and they must not corrupt a line.
 inline bool filter(uint8_t byte) {
-    switch (byte) {
-        case '?':
-            g_pending |= kStatusReport;
-            return true;
-        case '!':
-            g_pending |= kFeedHold;
-            return true;
-        case '~':
-            g_pending |= kCycleStart;
-            return true;
-        case 0x18:
-            g_pending |= kReset;
-            return true;
-        default:
-            break;
+    // One read-modify-write of g_pending for the four commands (not one per case).
+    uint8_t bit = 0;
+    if (byte == '?') bit = kStatusReport;
+    if (byte == '!') bit = kFeedHold;
+    if (byte == '~') bit = kCycleStart;
+    if (byte == 0x18) bit = kReset;
+    if (bit != 0) {
+        g_pending |= bit;
+        return true;
     }
     if (byte < 0x84) return false;
     return byte <= 0x87 || (byte >= 0x90 && byte <= 0x9D) || byte == 0xA0 || byte == 0xA1;

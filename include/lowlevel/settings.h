@@ -61,6 +61,8 @@ void report();
 /// G54 work offsets, um. False (and zeros, rewritten) when the record is blank or corrupt.
 bool load_coord(int32_t (&um)[kAxes]);
 void save_coord(const int32_t (&um)[kAxes]);
+/// Writes zero G54 offsets (`$RST=#`).
+void clear_coord();
 
 } // namespace settings
 
