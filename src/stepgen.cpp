@@ -59,7 +59,7 @@ bool StepGen::begin(const MoveSpec& spec) {
     line_start(ln_.g, ln_.c);
     build_k_table(spec.group);
     ln_.k_err = 0;
-    return start_profile(spec, ln_.g.dist[0]);
+    return start_profile(spec);
 }
 
 inline void StepGen::take_spec(const MoveSpec& spec) {
@@ -75,18 +75,16 @@ inline void StepGen::take_spec(const MoveSpec& spec) {
     }
 }
 
-bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
+bool StepGen::start_profile(const MoveSpec& spec) {
     take_spec(spec);
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
-    prepare_profile(entry, spec.v_exit2, ticks);
+    prepare_profile(entry, spec.v_exit2, ref_len());
     // (read only while holding: a hold begun later sets them again)
     a_hold_ = prof_.a_entry;
     x2_hold_ = 0;
     active_ = true;
-    stopped_ = false;
-    seg_len_ = 1;
     return true;
 }
 
@@ -206,7 +204,7 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     cv_.ref_um = ref_um;
     cv_.x_q8 = 0;
     cv_.chord_left = 0; // no chord yet (fill_curve)
-    return start_profile(spec, ref_um);
+    return start_profile(spec);
 }
 
 void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
@@ -245,6 +243,8 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     // Exact cruise wait of the reference axis along the line: once per move.
     prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(t.set(feed_).mul(d1)).u32();
     root_valid_ = false;
+    stopped_ = false;
+    seg_len_ = 1;
     if (!curve_) {
         // The runs' periods at cruise, for fill_line (one product per axis set and move).
         const uint8_t sets = static_cast<uint8_t>(1u << (ln_.g.m - 1));
@@ -285,11 +285,9 @@ void StepGen::hold() {
 void StepGen::resume(uint32_t v_exit2) {
     holding_ = false;
     if (!stopped_) return;
-    stopped_ = false;
     v_exit2_ = v_exit2;
     origin_ = progress();
     prepare_profile(0, v_exit2, ref_len() - origin_);
-    seg_len_ = 1;
 }
 
 uint32_t StepGen::speed2() const {

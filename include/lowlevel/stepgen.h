@@ -141,8 +141,8 @@ class StepGen {
     bool begin_curve(const MoveSpec& spec);
     void prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks);
     void take_spec(const MoveSpec& spec);
-    /// What begin() and begin_curve() share: the speeds and the profile over `ticks`.
-    bool start_profile(const MoveSpec& spec, uint32_t ticks);
+    /// What begin() and begin_curve() share: the speeds and the profile over the whole move.
+    bool start_profile(const MoveSpec& spec);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
     /// Sets prof_.a_exit for the exit speed v_exit2 (at most A_cruise), then x2_decel_ and
