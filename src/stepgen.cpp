@@ -522,12 +522,8 @@ void StepGen::fill_line(RunQueue& q) {
 #if LL_STATS
         ++stats.segments;
 #endif
-        // A tick lasting kSegmentCycles already makes a one-tick segment, whatever the longest
-        // period: its product is only needed below that.
-        seg_len_ = at_cruise ? ln_.cruise_seg
-                   : delta >= static_cast<uint32_t>(kSegmentCycles) << 8
-                       ? 1
-                       : next_segment(delta, mul_shr(delta, ln_.kmax, 20), a_last_);
+        seg_len_ =
+            at_cruise ? ln_.cruise_seg : next_segment(delta, mul_shr(delta, ln_.kmax, 20), a_last_);
         if (left == len) finish_move(); // the line's end reached
     }
 }
