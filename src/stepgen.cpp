@@ -247,12 +247,15 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     seg_len_ = 1;
     if (!curve_) {
         // The runs' periods at cruise, for fill_line (one product per axis set and move).
+        // The longest is K_max's (mul_shr() is monotonic in the factor).
         const uint8_t sets = static_cast<uint8_t>(1u << (ln_.g.m - 1));
+        uint32_t longest = 0;
         for (uint8_t sub = 0; sub < sets; ++sub) {
-            ln_.cruise_period[sub] = mul_shr(prof_.cruise, ln_.k[sub], 20);
+            const uint32_t p = mul_shr(prof_.cruise, ln_.k[sub], 20);
+            ln_.cruise_period[sub] = p;
+            if (p > longest) longest = p;
         }
-        ln_.cruise_seg =
-            next_segment(prof_.cruise, mul_shr(prof_.cruise, ln_.kmax, 20), prof_.a_cruise);
+        ln_.cruise_seg = next_segment(prof_.cruise, longest, prof_.a_cruise);
     }
 }
 
