@@ -119,7 +119,9 @@ void StepGen::build_k_table(uint8_t group) {
         }
     }
     lens_valid_ = true;
-    uint64_t sum = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
+    // sum_g exact in two halves (n < 2^23, len < 2^32, m <= 6 terms): mul_wide() and a carry
+    // are smaller than avr-gcc 5.4's uint64_t (__umulsidi3, __adddi3, __lshrdi3 and the moves)
+    uint32_t sum_hi = 0, sum_lo = 0;
     uint32_t count_g = 0;
     uint32_t below = 0; // dist[i + 1], 0 past the last position
     for (uint8_t i = m, set = static_cast<uint8_t>(sets - 1); i-- > 0; set >>= 1) {
@@ -127,7 +129,10 @@ void StepGen::build_k_table(uint8_t group) {
         below = ln_.g.dist[i];
         uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
         if (len != 0 && n != 0) {
-            sum += static_cast<uint64_t>(n) * len;
+            uint32_t lo;
+            sum_hi += mul_wide(n, len, lo);
+            sum_lo += lo;
+            if (sum_lo < lo) ++sum_hi;
             count_g += n;
         }
     }
@@ -137,7 +142,7 @@ void StepGen::build_k_table(uint8_t group) {
         return;
     }
     Num r(count_g, 20);
-    r.div(num64(static_cast<uint32_t>(sum >> 32), static_cast<uint32_t>(sum)));
+    r.div(num64(sum_hi, sum_lo));
     uint32_t kmax = 0;
     uint32_t* kp = ln_.k;
     for (uint8_t sub = sets; sub; --sub) {
