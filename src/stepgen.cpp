@@ -227,7 +227,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     phi = psi;
     phi.mul(d1).mul(d1);
     Num& dn = psi; // psi is not needed any more: D in its place
-    dn.sqrt().mul(Num(len_q8_)).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
+    dn.sqrt().mul(len_q8_).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
     uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);
