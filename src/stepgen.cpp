@@ -226,7 +226,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     Num& phi = a_per_v2_; // phi in place: shifted to the profile's scale below
     phi = psi;
     phi.mul(d1).mul(d1);
-    Num& dn = psi; // psi is not needed any more: D in its place
+    Num& dn = psi;                                  // psi is not needed any more: D in its place
     dn.sqrt().mul(len_q8_).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
@@ -243,7 +243,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     prof_.d = remaining_ticks;
     prof_.a_cruise = a_of(v_nominal2_);
     prof_.a_entry = a_of(v_entry2);
-    set_a_exit(v_exit2);
+    set_a_exit(a_of(v_exit2));
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
     prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(t.set(feed_).mul(d1)).u32();
@@ -264,8 +264,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     }
 }
 
-void StepGen::set_a_exit(uint32_t v_exit2) {
-    uint32_t a = a_of(v_exit2);
+void StepGen::set_a_exit(uint32_t a) {
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
     // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
     // A_cruise everywhere (delta_at() skips it) and the end deceleration starts at its end
@@ -279,7 +278,7 @@ void StepGen::set_exit(uint32_t v_exit2) {
     if (v_exit2 == v_exit2_) return;   // called at every poll: usually no change
     if (x2_now() >= x2_decel_) return; // end deceleration already begun
     v_exit2_ = v_exit2;
-    set_a_exit(v_exit2);
+    set_a_exit(a_of(v_exit2));
 }
 
 void StepGen::hold() {
