@@ -46,16 +46,6 @@ bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     return true;
 }
 
-void line_start(const LineGeometry& g, LineCursor& c) {
-    c.x1 = 0;
-    uint32_t* pos = c.pos;
-    uint32_t* frac = c.frac;
-    for (uint8_t j = g.m; j; --j) {
-        *pos++ = 0;
-        *frac++ = 1ul << (kLineUnit - 1); // P/2
-    }
-}
-
 void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[kAxes]) {
     c.x1 += len;
     c.pos[0] += len;

@@ -51,7 +51,16 @@ struct LineCursor {
     uint32_t frac[kAxes]; ///< fractional part of S_j * x_1 + P/2, k bits, in kLineUnit units
 };
 
-void line_start(const LineGeometry& g, LineCursor& c);
+/// (Inline: StepGen::begin() takes it without a call.)
+inline void line_start(const LineGeometry& g, LineCursor& c) {
+    c.x1 = 0;
+    uint32_t* pos = c.pos;
+    uint32_t* frac = c.frac;
+    for (uint8_t j = g.m; j; --j) {
+        *pos++ = 0;
+        *frac++ = 1ul << (kLineUnit - 1); // P/2
+    }
+}
 
 /// Moves the macro position `len` reference ticks further (1 <= len <= kMaxSegmentTicks and
 /// len <= dist[0] - x1) and writes the increment of each sorted position into e[0..m).
