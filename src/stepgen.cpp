@@ -55,6 +55,10 @@ bool StepGen::begin(const MoveSpec& spec) {
     pushed_position(start_); // the previous move is complete: start from its end
     curve_ = nullptr;
     if (spec.curve) return begin_curve(spec);
+    return begin_line(spec);
+}
+
+bool StepGen::begin_line(const MoveSpec& spec) {
     if (!line_setup(ln_.g, spec.delta)) return false; // (it leaves m = 0)
     line_start(ln_.g, ln_.c);
     build_k_table(spec.group);

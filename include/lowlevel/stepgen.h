@@ -139,6 +139,9 @@ class StepGen {
 
   private:
     bool begin_curve(const MoveSpec& spec);
+    /// A line's part of begin() (out of line: begin()'s frame, under begin_curve(), stays
+    /// small).
+    bool begin_line(const MoveSpec& spec);
     void prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks);
     void take_spec(const MoveSpec& spec);
     /// What begin() and begin_curve() share: the speeds and the profile over the whole move.
