@@ -92,7 +92,9 @@ bool StepGen::start_profile(const MoveSpec& spec) {
     return true;
 }
 
-void StepGen::build_k_table(uint8_t group) {
+// Inline in begin_line(), its one caller (-8 B; its frame there, 48 B, stays below
+// begin_curve()'s 66 B under the same begin() and start_profile()).
+__attribute__((always_inline)) inline void StepGen::build_k_table(uint8_t group) {
     const uint8_t m = ln_.g.m;
     // Machine-axis bits of each set: the sets with sorted position j (bit j - 1 of the index)
     // are those without it plus its axis (the reference axis joins the empty set in place).
@@ -115,35 +117,35 @@ void StepGen::build_k_table(uint8_t group) {
     // The step lengths (one square root each) depend on the axis sets only: kept from the
     // previous line (consecutive lines mostly move the same axes in the same order).
     uint32_t* lens = ln_.lens;
-    for (uint8_t sub = 0; sub < sets; ++sub) {
-        uint8_t set = static_cast<uint8_t>(ln_.mask[sub] & group);
-        if (!lens_valid_ || ln_.lens_set[sub] != set) {
-            ln_.lens_set[sub] = set;
-            lens[sub] = step_length(*lengths_, set);
+    uint32_t sum_hi, sum_lo, count_g;
+    for (;;) {
+        for (uint8_t sub = 0; sub < sets; ++sub) {
+            uint8_t set = static_cast<uint8_t>(ln_.mask[sub] & group);
+            if (!lens_valid_ || ln_.lens_set[sub] != set) {
+                ln_.lens_set[sub] = set;
+                lens[sub] = step_length(*lengths_, set);
+            }
         }
-    }
-    lens_valid_ = true;
-    // sum_g exact in two halves (n < 2^23, len < 2^32, m <= 6 terms): mul_wide() and a carry
-    // are smaller than avr-gcc 5.4's uint64_t (__umulsidi3, __adddi3, __lshrdi3 and the moves)
-    uint32_t sum_hi = 0, sum_lo = 0;
-    uint32_t count_g = 0;
-    uint32_t below = 0; // dist[i + 1], 0 past the last position
-    for (uint8_t i = m, set = static_cast<uint8_t>(sets - 1); i-- > 0; set >>= 1) {
-        uint32_t n = ln_.g.dist[i] - below;
-        below = ln_.g.dist[i];
-        uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
-        if (len != 0 && n != 0) {
-            uint32_t lo;
-            sum_hi += mul_wide(n, len, lo);
-            sum_lo += lo;
-            if (sum_lo < lo) ++sum_hi;
-            count_g += n;
+        lens_valid_ = true;
+        // sum_g exact in two halves (n < 2^23, len < 2^32, m <= 6 terms): mul_wide() and a carry
+        // are smaller than avr-gcc 5.4's uint64_t (__umulsidi3, __adddi3, __lshrdi3 and the moves)
+        sum_hi = sum_lo = count_g = 0;
+        uint32_t below = 0; // dist[i + 1], 0 past the last position
+        for (uint8_t i = m, set = static_cast<uint8_t>(sets - 1); i-- > 0; set >>= 1) {
+            uint32_t n = ln_.g.dist[i] - below;
+            below = ln_.g.dist[i];
+            uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
+            if (len != 0 && n != 0) {
+                uint32_t lo;
+                sum_hi += mul_wide(n, len, lo);
+                sum_lo += lo;
+                if (sum_lo < lo) ++sum_hi;
+                count_g += n;
+            }
         }
-    }
-    if (count_g == 0) {
+        if (count_g != 0) break;
         // No axis of the regulated group moves: regulate the moving axes themselves.
-        build_k_table(0xFF);
-        return;
+        group = 0xFF;
     }
     Num r(count_g, 20);
     r.div(num64(sum_hi, sum_lo));
