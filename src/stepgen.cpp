@@ -588,10 +588,11 @@ void StepGen::fill_curve(RunQueue& q) {
         // rotation of the three bits by plane = 2 - axes[2] to the right.
         const uint8_t plane = static_cast<uint8_t>(2 - cv_.axes[2]);
         uint8_t run_steps = 0, run_dirs = 0, run_count = 0;
+        // One emit() for both ends of a run: a sample that differs, or none left.
         uint8_t i = 0;
-        for (; i < n; ++i) {
-            uint8_t moved, neg;
-            if (!cv_.w.next(moved, neg)) break;
+        for (;; ++i) {
+            uint8_t moved = 0, neg = 0;
+            const bool more = i < n && cv_.w.next(moved, neg);
             uint8_t steps = static_cast<uint8_t>(moved * 9u), dirs = static_cast<uint8_t>(neg * 9u);
             for (uint8_t p = plane; p; --p) {
                 steps = static_cast<uint8_t>(steps >> 1);
@@ -599,17 +600,17 @@ void StepGen::fill_curve(RunQueue& q) {
             }
             steps &= 7;
             dirs &= 7;
-            if (run_count != 0 && (steps != run_steps || (steps && dirs != run_dirs))) {
+            if (run_count != 0 && (!more || steps != run_steps || (steps && dirs != run_dirs))) {
                 emit(q, run_steps, run_dirs, run_count, period_q8);
                 run_count = 0;
             }
+            if (!more) break;
             if (run_count == 0) {
                 run_steps = steps;
                 run_dirs = steps ? dirs : run_dirs;
             }
             ++run_count;
         }
-        if (run_count != 0) emit(q, run_steps, run_dirs, run_count, period_q8);
         cv_.x_q8 += chord_q8 * i;
         // Kept only for a segment actually made: the chip and the host model stop at different
         // times for room, and must still use the same chord for the same samples.
