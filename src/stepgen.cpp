@@ -84,7 +84,7 @@ bool StepGen::start_profile(const MoveSpec& spec) {
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
-    prepare_profile(entry, spec.v_exit2, ref_len());
+    prepare_profile(entry, spec.v_exit2);
     // (read only while holding: a hold begun later sets them again)
     a_hold_ = prof_.a_entry;
     x2_hold_ = 0;
@@ -218,8 +218,9 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     return start_profile(spec);
 }
 
-void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
+void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2) {
     const uint32_t d1 = ref_len();
+    const uint32_t remaining_ticks = d1 - origin_;
     // From psi = 1 / (dv2 d_1), one division (dv2 = 2 a L, a = 128000 dv2 / len_q8):
     // fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
     //   l = v^2 rho / (2 a), rho = 256000 d_1 / len_q8 ticks per mm, so phi = d_1 / dv2 = psi
@@ -300,7 +301,7 @@ void StepGen::resume(uint32_t v_exit2) {
     if (!stopped_) return;
     v_exit2_ = v_exit2;
     origin_ = progress();
-    prepare_profile(0, v_exit2, ref_len() - origin_);
+    prepare_profile(0, v_exit2);
 }
 
 uint32_t StepGen::speed2() const {

@@ -142,7 +142,9 @@ class StepGen {
     /// A line's part of begin() (out of line: begin()'s frame, under begin_curve(), stays
     /// small).
     bool begin_line(const MoveSpec& spec);
-    void prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks);
+    /// The profile from origin_ (set first) to the move's end; also clears stopped_ and makes
+    /// the first segment one tick.
+    void prepare_profile(uint32_t v_entry2, uint32_t v_exit2);
     void take_spec(const MoveSpec& spec);
     /// What begin() and begin_curve() share: the speeds and the profile over the whole move.
     bool start_profile(const MoveSpec& spec);
