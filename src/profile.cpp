@@ -4,17 +4,6 @@
 
 namespace ll {
 
-uint32_t profile_x2_decel(const Profile& p) {
-    const uint8_t half = static_cast<uint8_t>(p.log_s - 1); // s / 2 = 2^half
-    uint32_t drop = (p.a_cruise - p.a_exit) >> half;        // half ticks to decelerate from cruise
-    uint32_t x2 = drop >= 2 * p.d ? 0 : 2 * p.d - drop;
-    if (p.a_entry <= p.a_cruise) {
-        uint32_t meet = (add_sat(p.a_exit, shl_sat(p.d, p.log_s)) - p.a_entry) >> p.log_s;
-        if (meet > x2) x2 = meet;
-    }
-    return x2;
-}
-
 uint32_t profile_a(const Profile& p, uint32_t x2) {
 #if defined(__AVR__)
     // r16 marked as used: with it the saved registers are one run (r4..r17), which -mcall-prologues

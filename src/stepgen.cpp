@@ -55,11 +55,15 @@ bool StepGen::begin(const MoveSpec& spec) {
     pushed_position(start_); // the previous move is complete: start from its end
     curve_ = nullptr;
     if (spec.curve) return begin_curve(spec);
+    return begin_line(spec);
+}
+
+bool StepGen::begin_line(const MoveSpec& spec) {
     if (!line_setup(ln_.g, spec.delta)) return false; // (it leaves m = 0)
     line_start(ln_.g, ln_.c);
     build_k_table(spec.group);
     ln_.k_err = 0;
-    return start_profile(spec, ln_.g.dist[0]);
+    return start_profile(spec);
 }
 
 inline void StepGen::take_spec(const MoveSpec& spec) {
@@ -75,22 +79,22 @@ inline void StepGen::take_spec(const MoveSpec& spec) {
     }
 }
 
-bool StepGen::start_profile(const MoveSpec& spec, uint32_t ticks) {
+bool StepGen::start_profile(const MoveSpec& spec) {
     take_spec(spec);
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
-    prepare_profile(entry, spec.v_exit2, ticks);
+    prepare_profile(entry, spec.v_exit2);
     // (read only while holding: a hold begun later sets them again)
     a_hold_ = prof_.a_entry;
     x2_hold_ = 0;
     active_ = true;
-    stopped_ = false;
-    seg_len_ = 1;
     return true;
 }
 
-void StepGen::build_k_table(uint8_t group) {
+// Inline in begin_line(), its one caller (-8 B; its frame there, 48 B, stays below
+// begin_curve()'s 66 B under the same begin() and start_profile()).
+__attribute__((always_inline)) inline void StepGen::build_k_table(uint8_t group) {
     const uint8_t m = ln_.g.m;
     // Machine-axis bits of each set: the sets with sorted position j (bit j - 1 of the index)
     // are those without it plus its axis (the reference axis joins the empty set in place).
@@ -113,33 +117,38 @@ void StepGen::build_k_table(uint8_t group) {
     // The step lengths (one square root each) depend on the axis sets only: kept from the
     // previous line (consecutive lines mostly move the same axes in the same order).
     uint32_t* lens = ln_.lens;
-    for (uint8_t sub = 0; sub < sets; ++sub) {
-        uint8_t set = static_cast<uint8_t>(ln_.mask[sub] & group);
-        if (!lens_valid_ || ln_.lens_set[sub] != set) {
-            ln_.lens_set[sub] = set;
-            lens[sub] = step_length(*lengths_, set);
+    uint32_t sum_hi, sum_lo, count_g;
+    for (;;) {
+        for (uint8_t sub = 0; sub < sets; ++sub) {
+            uint8_t set = static_cast<uint8_t>(ln_.mask[sub] & group);
+            if (!lens_valid_ || ln_.lens_set[sub] != set) {
+                ln_.lens_set[sub] = set;
+                lens[sub] = step_length(*lengths_, set);
+            }
         }
-    }
-    lens_valid_ = true;
-    uint64_t sum = 0; // exact: n < 2^23, len < 2^32, m <= 6 terms
-    uint32_t count_g = 0;
-    uint32_t below = 0; // dist[i + 1], 0 past the last position
-    for (uint8_t i = m, set = static_cast<uint8_t>(sets - 1); i-- > 0; set >>= 1) {
-        uint32_t n = ln_.g.dist[i] - below;
-        below = ln_.g.dist[i];
-        uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
-        if (len != 0 && n != 0) {
-            sum += static_cast<uint64_t>(n) * len;
-            count_g += n;
+        lens_valid_ = true;
+        // sum_g exact in two halves (n < 2^23, len < 2^32, m <= 6 terms): mul_wide() and a carry
+        // are smaller than avr-gcc 5.4's uint64_t (__umulsidi3, __adddi3, __lshrdi3 and the moves)
+        sum_hi = sum_lo = count_g = 0;
+        uint32_t below = 0; // dist[i + 1], 0 past the last position
+        for (uint8_t i = m, set = static_cast<uint8_t>(sets - 1); i-- > 0; set >>= 1) {
+            uint32_t n = ln_.g.dist[i] - below;
+            below = ln_.g.dist[i];
+            uint32_t len = lens[set]; // the set of sorted positions 0..i: (1 << i) - 1
+            if (len != 0 && n != 0) {
+                uint32_t lo;
+                sum_hi += mul_wide(n, len, lo);
+                sum_lo += lo;
+                if (sum_lo < lo) ++sum_hi;
+                count_g += n;
+            }
         }
-    }
-    if (count_g == 0) {
+        if (count_g != 0) break;
         // No axis of the regulated group moves: regulate the moving axes themselves.
-        build_k_table(0xFF);
-        return;
+        group = 0xFF;
     }
     Num r(count_g, 20);
-    r.div(num64(static_cast<uint32_t>(sum >> 32), static_cast<uint32_t>(sum)));
+    r.div(num64(sum_hi, sum_lo));
     uint32_t kmax = 0;
     uint32_t* kp = ln_.k;
     for (uint8_t sub = sets; sub; --sub) {
@@ -206,11 +215,12 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     cv_.ref_um = ref_um;
     cv_.x_q8 = 0;
     cv_.chord_left = 0; // no chord yet (fill_curve)
-    return start_profile(spec, ref_um);
+    return start_profile(spec);
 }
 
-void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t remaining_ticks) {
+void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2) {
     const uint32_t d1 = ref_len();
+    const uint32_t remaining_ticks = d1 - origin_;
     // From psi = 1 / (dv2 d_1), one division (dv2 = 2 a L, a = 128000 dv2 / len_q8):
     // fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
     //   l = v^2 rho / (2 a), rho = 256000 d_1 / len_q8 ticks per mm, so phi = d_1 / dv2 = psi
@@ -223,8 +233,8 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     Num& phi = a_per_v2_; // phi in place: shifted to the profile's scale below
     phi = psi;
     phi.mul(d1).mul(d1);
-    Num& dn = psi; // psi is not needed any more: D in its place
-    dn.sqrt().mul(Num(len_q8_)).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
+    Num& dn = psi;                                  // psi is not needed any more: D in its place
+    dn.sqrt().mul(len_q8_).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
     uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);
@@ -240,24 +250,28 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2, uint32_t rema
     prof_.d = remaining_ticks;
     prof_.a_cruise = a_of(v_nominal2_);
     prof_.a_entry = a_of(v_entry2);
-    set_a_exit(v_exit2);
+    set_a_exit(a_of(v_exit2));
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
     prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(t.set(feed_).mul(d1)).u32();
     root_valid_ = false;
+    stopped_ = false;
+    seg_len_ = 1;
     if (!curve_) {
         // The runs' periods at cruise, for fill_line (one product per axis set and move).
+        // The longest is K_max's (mul_shr() is monotonic in the factor).
         const uint8_t sets = static_cast<uint8_t>(1u << (ln_.g.m - 1));
+        uint32_t longest = 0;
         for (uint8_t sub = 0; sub < sets; ++sub) {
-            ln_.cruise_period[sub] = mul_shr(prof_.cruise, ln_.k[sub], 20);
+            const uint32_t p = mul_shr(prof_.cruise, ln_.k[sub], 20);
+            ln_.cruise_period[sub] = p;
+            if (p > longest) longest = p;
         }
-        ln_.cruise_seg =
-            next_segment(prof_.cruise, mul_shr(prof_.cruise, ln_.kmax, 20), prof_.a_cruise);
+        ln_.cruise_seg = next_segment(prof_.cruise, longest, prof_.a_cruise);
     }
 }
 
-void StepGen::set_a_exit(uint32_t v_exit2) {
-    uint32_t a = a_of(v_exit2);
+void StepGen::set_a_exit(uint32_t a) {
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
     // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
     // A_cruise everywhere (delta_at() skips it) and the end deceleration starts at its end
@@ -271,7 +285,7 @@ void StepGen::set_exit(uint32_t v_exit2) {
     if (v_exit2 == v_exit2_) return;   // called at every poll: usually no change
     if (x2_now() >= x2_decel_) return; // end deceleration already begun
     v_exit2_ = v_exit2;
-    set_a_exit(v_exit2);
+    set_a_exit(a_of(v_exit2));
 }
 
 void StepGen::hold() {
@@ -285,11 +299,9 @@ void StepGen::hold() {
 void StepGen::resume(uint32_t v_exit2) {
     holding_ = false;
     if (!stopped_) return;
-    stopped_ = false;
     v_exit2_ = v_exit2;
     origin_ = progress();
-    prepare_profile(0, v_exit2, ref_len() - origin_);
-    seg_len_ = 1;
+    prepare_profile(0, v_exit2);
 }
 
 uint32_t StepGen::speed2() const {
@@ -524,12 +536,8 @@ void StepGen::fill_line(RunQueue& q) {
 #if LL_STATS
         ++stats.segments;
 #endif
-        // A tick lasting kSegmentCycles already makes a one-tick segment, whatever the longest
-        // period: its product is only needed below that.
-        seg_len_ = at_cruise ? ln_.cruise_seg
-                   : delta >= static_cast<uint32_t>(kSegmentCycles) << 8
-                       ? 1
-                       : next_segment(delta, mul_shr(delta, ln_.kmax, 20), a_last_);
+        seg_len_ =
+            at_cruise ? ln_.cruise_seg : next_segment(delta, mul_shr(delta, ln_.kmax, 20), a_last_);
         if (left == len) finish_move(); // the line's end reached
     }
 }
@@ -581,10 +589,11 @@ void StepGen::fill_curve(RunQueue& q) {
         // rotation of the three bits by plane = 2 - axes[2] to the right.
         const uint8_t plane = static_cast<uint8_t>(2 - cv_.axes[2]);
         uint8_t run_steps = 0, run_dirs = 0, run_count = 0;
+        // One emit() for both ends of a run: a sample that differs, or none left.
         uint8_t i = 0;
-        for (; i < n; ++i) {
-            uint8_t moved, neg;
-            if (!cv_.w.next(moved, neg)) break;
+        for (;; ++i) {
+            uint8_t moved = 0, neg = 0;
+            const bool more = i < n && cv_.w.next(moved, neg);
             uint8_t steps = static_cast<uint8_t>(moved * 9u), dirs = static_cast<uint8_t>(neg * 9u);
             for (uint8_t p = plane; p; --p) {
                 steps = static_cast<uint8_t>(steps >> 1);
@@ -592,17 +601,17 @@ void StepGen::fill_curve(RunQueue& q) {
             }
             steps &= 7;
             dirs &= 7;
-            if (run_count != 0 && (steps != run_steps || (steps && dirs != run_dirs))) {
+            if (run_count != 0 && (!more || steps != run_steps || (steps && dirs != run_dirs))) {
                 emit(q, run_steps, run_dirs, run_count, period_q8);
                 run_count = 0;
             }
+            if (!more) break;
             if (run_count == 0) {
                 run_steps = steps;
                 run_dirs = steps ? dirs : run_dirs;
             }
             ++run_count;
         }
-        if (run_count != 0) emit(q, run_steps, run_dirs, run_count, period_q8);
         cv_.x_q8 += chord_q8 * i;
         // Kept only for a segment actually made: the chip and the host model stop at different
         // times for room, and must still use the same chord for the same samples.

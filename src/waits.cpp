@@ -13,14 +13,6 @@ void step_lengths_build(StepLengths& t, const uint32_t steps_per_unit_milli[kAxe
     }
 }
 
-uint32_t step_length(const StepLengths& t, uint8_t set) {
-    Num sum{};
-    for (uint8_t a = 0; a < kAxes; ++a, set >>= 1) {
-        if (set & 1) sum.add(t.inv2[a]);
-    }
-    return sum.sqrt().shift(30).u32(); // Q30
-}
-
 uint32_t wait_q8(const StepLengths& t, uint8_t set, uint8_t group, uint32_t speed) {
     // Delta = len / V; len in mm x 2^30, V in mm/min x 1000:
     // cycles x 256 = len * 2^-30 * 60 * kCpuHz * 1000 * 256 / speed

@@ -85,7 +85,7 @@ void walk(const int32_t delta[ll::kAxes], uint8_t len, Dev& d,
 void section_line() {
     std::printf("## Line positions (seed §7.2)\n\n");
     int32_t ex[ll::kAxes] = {1000, 500, 490, 0};
-    ll::LineGeometry g;
+    ll::LineGeometry g{}; // (line_setup() is inline: gcc sees its refusal leave g unset)
     ll::line_setup(g, ex);
     std::printf("line (1000, 500, 490): k = %u, P = 2^k = %lu (>= 8 d_1 = %lu)\n", g.shift,
                 1ul << g.shift, 8ul * g.dist[0]);

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "lowlevel/config.h"
+#include "lowlevel/fixmath.h"
 
 namespace ll {
 
@@ -42,7 +43,48 @@ struct LineGeometry {
 
 /// Sets up the line from the per-axis deltas (ticks). Returns false (with m = 0) for a
 /// zero-length line or one longer than kMaxLineTicks on its reference axis.
-bool line_setup(LineGeometry& g, const int32_t delta[kAxes]);
+/// (Inline: StepGen::begin_line() takes it without a call.)
+inline bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
+    g.m = 0;
+    g.dirs = 0;
+    // §7.1: drop still axes, insertion-sort the rest by distance, decreasing. Ties keep the
+    // machine-axis order so that the result is deterministic.
+    uint8_t bit = 1;
+    for (uint8_t a = 0; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
+        int32_t d = delta[a];
+        if (d == 0) continue;
+        uint32_t dist = d < 0 ? static_cast<uint32_t>(-(d + 1)) + 1u : static_cast<uint32_t>(d);
+        if (d < 0) g.dirs = static_cast<uint8_t>(g.dirs | bit);
+        uint8_t i = g.m;
+        while (i > 0 && g.dist[i - 1] < dist) {
+            g.dist[i] = g.dist[i - 1];
+            g.axis[i] = g.axis[i - 1];
+            --i;
+        }
+        g.dist[i] = dist;
+        g.axis[i] = a;
+        ++g.m;
+    }
+    if (g.m == 0 || g.dist[0] > kMaxLineTicks) {
+        g.m = 0; // refused: nothing to move
+        return false;
+    }
+
+    // §7.2: P = 2^k, the smallest power of two with P >= 8 d_1.
+    uint32_t d1 = g.dist[0];
+    uint8_t k = 3;
+    for (uint32_t v = d1 - 1; v; v >>= 1) ++k; // 2^(k - 3) >= d_1: the bits of d_1 - 1
+    g.shift = k;
+    g.slope[0] = 1ul << kLineUnit;
+    for (uint8_t j = 1; j < g.m; ++j) {
+        // round(d_j * 2^k / d_1) = floor((2 d_j * 2^k / d_1 + 1) / 2), then in units of
+        // 2^(kLineUnit - k) (the same value, aligned: line_advance shifts by a constant).
+        uint32_t twice = div_frac(g.dist[j], d1, static_cast<uint8_t>(k + 1));
+        g.slope[j] =
+            shl_sat((twice + 1) >> 1, static_cast<uint8_t>(kLineUnit - k)); // (no overflow)
+    }
+    return true;
+}
 
 /// Macro position along a line (seed §2.1), in ticks travelled per sorted position.
 struct LineCursor {
@@ -51,7 +93,16 @@ struct LineCursor {
     uint32_t frac[kAxes]; ///< fractional part of S_j * x_1 + P/2, k bits, in kLineUnit units
 };
 
-void line_start(const LineGeometry& g, LineCursor& c);
+/// (Inline: StepGen::begin() takes it without a call.)
+inline void line_start(const LineGeometry& g, LineCursor& c) {
+    c.x1 = 0;
+    uint32_t* pos = c.pos;
+    uint32_t* frac = c.frac;
+    for (uint8_t j = g.m; j; --j) {
+        *pos++ = 0;
+        *frac++ = 1ul << (kLineUnit - 1); // P/2
+    }
+}
 
 /// Moves the macro position `len` reference ticks further (1 <= len <= kMaxSegmentTicks and
 /// len <= dist[0] - x1) and writes the increment of each sorted position into e[0..m).

@@ -21,6 +21,8 @@
 
 #include <stdint.h>
 
+#include "lowlevel/fixmath.h"
+
 namespace ll {
 
 struct Profile {
@@ -39,7 +41,17 @@ struct Profile {
 /// where the start and end lines meet, the move decelerates from max(x_d, x*) when it
 /// accelerates at its start (x* > x_d exactly when the cruise speed is out of reach, and the
 /// peak is then A(x*) = (A_entry + A_exit + s d) / 2), and from x_d otherwise.
-uint32_t profile_x2_decel(const Profile& p);
+/// (Inline: its one caller on the chip, StepGen::set_a_exit(), takes it without a call.)
+inline uint32_t profile_x2_decel(const Profile& p) {
+    const uint8_t half = static_cast<uint8_t>(p.log_s - 1); // s / 2 = 2^half
+    uint32_t drop = (p.a_cruise - p.a_exit) >> half;        // half ticks to decelerate from cruise
+    uint32_t x2 = drop >= 2 * p.d ? 0 : 2 * p.d - drop;
+    if (p.a_entry <= p.a_cruise) {
+        uint32_t meet = (add_sat(p.a_exit, shl_sat(p.d, p.log_s)) - p.a_entry) >> p.log_s;
+        if (meet > x2) x2 = meet;
+    }
+    return x2;
+}
 
 /// A at half-tick position x2 = 2 x (so that segment midpoints are exact):
 ///   A(x) = min(start(x), A_exit + s (d - x)), start(x) = A_entry +- s x clamped at A_cruise.

@@ -25,7 +25,14 @@ struct StepLengths {
 void step_lengths_build(StepLengths& t, const uint32_t steps_per_unit_milli[kAxes]);
 
 /// Length of one micro step on the axis set `set`, mm x 2^30 (Q30): below 4 mm for T >= 1.
-uint32_t step_length(const StepLengths& t, uint8_t set);
+/// (Inline: on the chip only StepGen::begin_line() calls it.)
+inline uint32_t step_length(const StepLengths& t, uint8_t set) {
+    Num sum{};
+    for (uint8_t a = 0; a < kAxes; ++a, set >>= 1) {
+        if (set & 1) sum.add(t.inv2[a]);
+    }
+    return sum.sqrt().shift(30).u32(); // Q30
+}
 
 /// Delta_P of §3.2 in CPU cycles x 256 for the axis set `set` restricted to `group`, at a
 /// regulated speed of `speed` units/min x1000. Used where a single wait is needed outside a
