@@ -136,13 +136,13 @@ enum Word : uint8_t {
     kWordK,
     kWordQ,
     kWordR,
+    kWordS,
     kWordN,
     kWordL,
-    kWordS,
     kWordT,
     kWordCount
 };
-static_assert(kWordS > kWordN && kWordT == kWordCount - 1, "N L S T last");
+static_assert(kWordS < kWordN && kWordT == kWordL + 1 && kWordT == kWordCount - 1, "S, N L T last");
 constexpr uint8_t kDecimalSlots = kWordR + 1;
 constexpr uint8_t kLetterG = 0xFD, kLetterM = 0xFE, kLetterNone = 0xFF;
 
@@ -196,9 +196,9 @@ struct Block {
     uint8_t axis_command;
     uint8_t overflow; // an offset or target does not fit an int32 (see add())
     uint8_t l;        // L, 0xFF when not an integer 0..254
-    uint8_t tool;
-    uint16_t groups; // modal groups commanded in this block
-    WordMask words;  // value words present, bit(Word)
+    uint8_t tool;     // T (l and tool in a row, as kWordL and kWordT)
+    uint16_t groups;  // modal groups commanded in this block
+    WordMask words;   // value words present, bit(Word)
     // As State::feed, spindle_speed and line_number (copied as one).
     uint32_t feed;
     uint32_t s;
@@ -213,6 +213,7 @@ struct Block {
 };
 static_assert(sizeof(CurveParams) <= kWordP * sizeof(Slot),
               "the curve overlays the axis and F slots only");
+static_assert(offsetof(Block, tool) == offsetof(Block, l) + 1, "L and T in a row");
 static_assert(offsetof(Block, n) - offsetof(Block, feed) ==
                   offsetof(State, line_number) - offsetof(State, feed),
               "feed, S and N are laid out as in State");
@@ -306,16 +307,14 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
     } else if (word >= kWordN) { // N L T (the last words)
         // N 0..10000000 and L 0..254 (else checked in stage 3), T 0..255.
         uint32_t v;
-        if (!num::to_uint(d, word == kWordN ? 10000000u : word == kWordL ? 254u : 255u, v)) {
+        if (!num::to_uint(d, word == kWordN ? 10000000u : 254u + word - kWordL, v)) {
             if (word == kWordT) return d.integral() ? kMaxValueExceeded : kCommandValueNotInteger;
             v = kNoLineNumber; // for L: 0xFF
         }
         if (word == kWordN) {
             b.n = v;
-        } else if (word == kWordL) {
-            b.l = static_cast<uint8_t>(v);
         } else {
-            b.tool = static_cast<uint8_t>(v);
+            (&b.l)[word - kWordL] = static_cast<uint8_t>(v); // L, T: Block::l, tool
         }
     }
     return kOk;
