@@ -462,6 +462,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     // o: the plane's offsets (I J, I K or J K), then P and Q, in um; kept in c.a_um and c.b_um
     // (a row of 4: checked in curve_in_range) until they become the points.
     int32_t* const o = c.a_um;
+    bool pq_not_positive = false; // an ellipse's semi-axes must be above 0
     for (uint8_t k = 0; k < 4; ++k) {
         uint8_t word = static_cast<uint8_t>(k < 2 ? kWordI + ax[k] : k == 2 ? kWordP : kWordQ);
         o[k] = 0;
@@ -469,6 +470,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         if (k < 2) {
             c.start_um[k] = st.position[ax[k]];
             c.end_um[k] = work().req.target_um[ax[k]];
+        } else if (o[k] <= 0) {
+            pq_not_positive = true;
         }
     }
     int32_t d[2]; // end - start
@@ -491,9 +494,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         // axes; both ends on the ellipse within one tick + 0.002 mm (in curve_in_range()).
         if (!has_offsets) return kNoOffsetsInPlane;
         if (!has_pq) return kValueWordMissing;
-        for (uint8_t k = 2; k < 4; ++k) {
-            if (o[k] <= 0) return kNegativeValue;
-        }
+        if (pq_not_positive) return kNegativeValue;
     } else {
         // G2 / G3, as GRBL: radius mode (R) or centre mode (the plane's offsets).
         used = bit(kWordP);
