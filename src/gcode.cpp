@@ -522,7 +522,10 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             for (uint8_t k = 0; k < 2; ++k) {
                 int32_t t = static_cast<int32_t>(h.of(abs32(d[1 - k])));
                 if ((d[1 - k] < 0) != neg) t = -t;
-                o[k] = (d[k] + t) / 2;
+                // (d[k] + t) / 2, rounded toward zero as the division would be (without the
+                // library's 32-bit division: the sign bit added, then an arithmetic shift).
+                uint32_t sum = static_cast<uint32_t>(d[k]) + static_cast<uint32_t>(t);
+                o[k] = static_cast<int32_t>(sum + (sum >> 31)) >> 1;
                 neg = !neg;
             }
         } else if (!has_offsets) {
