@@ -416,11 +416,13 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
         }
     } else {
         const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
+        // The ends' directions, the end first for a clockwise arc: its sweep is then the
+        // counter-clockwise one from the end to the start (sweep_q29 swaps them so), >= 0.
         int32_t cs[4];
         for (uint8_t e = 0; e < 2; ++e) {
             int32_t p[2];
             sub2(p, row + 2 * e, c.a_um);
-            int32_t* cse = &cs[2 * e];
+            int32_t* cse = &cs[2 * (e ^ c.clockwise)];
             ellipse_direction(p[0], p[1], radii, cse[0], cse[1]);
             for (uint8_t k = 0; k < 2; ++k) {
                 uint32_t on = Num(abs32(cse[k]), -30).mul(radii[k]).u32(); // r |cs| (Q30)
@@ -428,9 +430,9 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
                 if (abs32(static_cast<int32_t>(d)) > gap_um) return false;
             }
         }
-        int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], c.clockwise != 0, c.turns);
-        // |sweep| < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r |sweep|.
-        uint32_t q21 = static_cast<uint32_t>((sweep < 0 ? -sweep : sweep) >> 8);
+        int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], false, c.turns);
+        // 0 <= sweep < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r sweep.
+        uint32_t q21 = static_cast<uint32_t>(sweep >> 8);
         reach.set(q21, -21).mul(radii[0] > radii[1] ? radii[0] : radii[1]);
     }
     reach.add(Num(abs32(add(work().req.target_um[ax[2]], g_state.position[ax[2]], true))));
