@@ -379,6 +379,14 @@ __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
     return sum_squares(v, 2).sqrt();
 }
 
+// plane_axes() as a rotation: (u, v, w) = axes (k - plane) mod 3.
+__attribute__((noinline)) void axes_of(uint8_t plane, uint8_t ax[3]) {
+    for (uint8_t k = 0, a = static_cast<uint8_t>(plane ? 3 - plane : 0); k < 3; ++k) {
+        ax[k] = a;
+        a = a == 2 ? 0 : static_cast<uint8_t>(a + 1);
+    }
+}
+
 // The step generator's fixed-point range (docs/curves.md): the ends, the control points or the
 // centre, and the semi-axes, within 2^22 steps; the length within 2^23 um (an arc's is at most
 // its larger semi-axis times its sweep; a Bezier's at most its control polygon's), and the
@@ -386,8 +394,9 @@ __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
 // each coordinate that close to the ellipse's point that has the same direction in the
 // ellipse's own scale (ellipse_direction). (A function of its own, called by execute() after
 // check_curve(): a small stack frame, not on top of check_curve()'s.)
-__attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_t ax[3],
-                                              bool ellipse) {
+__attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse) {
+    uint8_t ax[3];
+    axes_of(c.plane, ax);
     static_assert(offsetof(CurveParams, end_um) == offsetof(CurveParams, start_um) + 8 &&
                       offsetof(CurveParams, a_um) == offsetof(CurveParams, start_um) + 16 &&
                       offsetof(CurveParams, b_um) == offsetof(CurveParams, start_um) + 24,
@@ -445,11 +454,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
                                               const State& st, CurveParams& c) {
     uint8_t ax[3];
     const uint8_t plane = c.plane = b.g[kGroupPlane];
-    // plane_axes() as a rotation: (u, v, w) = axes (k - plane) mod 3.
-    for (uint8_t k = 0, a = static_cast<uint8_t>(plane ? 3 - plane : 0); k < 3; ++k) {
-        ax[k] = a;
-        a = a == 2 ? 0 : static_cast<uint8_t>(a + 1);
-    }
+    axes_of(plane, ax);
     // The normal of plane p is axis 2 - p (plane_axes), so the plane's axes are X Y Z but it.
     const uint8_t in_plane = static_cast<uint8_t>(7u ^ (4u >> plane));
     // A curve moves the plane's axes and, along a helix, the normal one: not the others.
@@ -739,9 +744,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
             if (r != kOk) return r;
             // Called here rather than under check_curve()'s frame: it reaches
             // ellipse_direction(), the deepest stack of a G-code line.
-            uint8_t ax[3];
-            plane_axes(b.curve.plane, ax);
-            if (!curve_in_range(b.curve, ax, ellipse)) return kInvalidTarget;
+            if (!curve_in_range(b.curve, ellipse)) return kInvalidTarget;
             curve = true;
         } else if (axes == 0) {
             b.axis_command = kAxisNone; // G0/G1 alone: a mode change only
