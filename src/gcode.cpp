@@ -653,10 +653,8 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
 
     // [19] The axis words in um, then the non-modal commands that use them, or the target.
     for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
-        if (!(m & 1)) continue;
-        int32_t um;
-        if (!length(a, um)) return kBadNumberFormat;
-        b.v[a].um = um;
+        // In place: length_to_milli() has read the number when it writes the um.
+        if ((m & 1) && !length(a, b.v[a].um)) return kBadNumberFormat;
     }
     // One pass over the axes computes either the new offsets (G10, G92) or the target of a
     // move: an axis without a word keeps `keep`, an axis with a word gets its value, turned
