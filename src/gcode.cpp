@@ -284,7 +284,10 @@ uint8_t import_command(Block& b, uint8_t m, const num::Decimal& d) {
     // As GRBL: the axis-word conflict is checked before the decimal and the modal group.
     if (value & kUsesAxes) {
         if (b.axis_command != kAxisNone) return kAxisCommandConflict;
-        b.axis_command = group == kGroupMotion ? kAxisMotion : kAxisNonModal;
+        // (Only the motion and the non-modal group's commands use axes.)
+        static_assert(kGroupNonModal + 1 == kAxisNonModal && kGroupMotion + 1 == kAxisMotion,
+                      "the axis command of a group is its number + 1");
+        b.axis_command = static_cast<uint8_t>(group + 1);
     }
     if (!found) return kCommandValueNotInteger;
     uint16_t gbit = static_cast<uint16_t>(1u << group);
