@@ -390,6 +390,14 @@ __attribute__((noinline)) void axes_of(uint8_t plane, uint8_t ax[3]) {
     }
 }
 
+// out = the coordinates of `from` along the plane's axes ax[0], ax[1].
+__attribute__((noinline)) void pick2(int32_t out[2], const int32_t* from, const uint8_t ax[2]) {
+    for (uint8_t k = 2; k != 0; --k) {
+        asm("" : "+r"(k)); // a loop: unrolled, the two copies take 78 B
+        *out++ = from[*ax++];
+    }
+}
+
 // The step generator's fixed-point range (docs/curves.md): the ends, the control points or the
 // centre, and the semi-axes, within 2^22 steps; the length within 2^23 um (an arc's is at most
 // its larger semi-axis times its sweep; a Bezier's at most its control polygon's), and the
@@ -477,13 +485,10 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         uint8_t word = static_cast<uint8_t>(k < 2 ? kWordI + ax[k] : k == 2 ? kWordP : kWordQ);
         o[k] = 0;
         if ((b.words & bit(word)) && !length(word, o[k])) return kBadNumberFormat;
-        if (k < 2) {
-            c.start_um[k] = st.position[ax[k]];
-            c.end_um[k] = work().req.target_um[ax[k]];
-        } else if (o[k] <= 0) {
-            pq_not_positive = true;
-        }
+        if (k >= 2 && o[k] <= 0) pq_not_positive = true;
     }
+    pick2(c.start_um, st.position, ax);
+    pick2(c.end_um, work().req.target_um, ax);
     int32_t d[2]; // end - start
     sub2(d, c.end_um, c.start_um);
     bool has_offsets = ((b.words >> kWordI) & in_plane) != 0; // I J K are X Y Z's offsets
