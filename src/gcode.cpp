@@ -446,7 +446,10 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
             ellipse_direction(p[0], p[1], radii, cse[0], cse[1]);
             for (uint8_t k = 0; k < 2; ++k) {
                 uint32_t on = Num(abs32(cse[k]), -30).mul(radii[k]).u32(); // r |cs| (Q30)
-                uint32_t d = static_cast<uint32_t>(p[k]) - (cse[k] < 0 ? 0u - on : on);
+                // p - sign(cs) on, as sign(cs) (sign(cs) p - on): the same magnitude.
+                uint32_t d = static_cast<uint32_t>(p[k]);
+                if (cse[k] < 0) d = 0u - d;
+                d -= on;
                 if (abs32(static_cast<int32_t>(d)) > gap_um) return false;
             }
         }
