@@ -362,23 +362,20 @@ void set_end_modes(Modal& m) {
     m.coolant = 9;
 }
 
-// p - q for two points of the plane (an overflow flags the block, as add() does).
-__attribute__((noinline)) void sub2(int32_t out[2], const int32_t p[2], const int32_t q[2]) {
-#if defined(__AVR__)
-    // r17 marked as used: with it the saved registers are one run (r10..r17, r28, r29), which
-    // -mcall-prologues saves through its shared routines, not 9 pushes and pops (-16 B; 2 B of
-    // stack, about 25 cycles a call, a few calls a curve block).
-    asm volatile("" ::: "r17");
-#endif
-    for (uint8_t k = 0; k < 2; ++k) out[k] = add(p[k], q[k], true);
+// p - q for two points of the plane (an overflow flags the block, as add() does), or with
+// `magnitudes` |p - q| per coordinate (as uint32_t: 2^31 for INT32_MIN).
+__attribute__((noinline)) void sub2(int32_t out[2], const int32_t p[2], const int32_t q[2],
+                                    bool magnitudes = false) {
+    for (uint8_t k = 0; k < 2; ++k) {
+        int32_t v = add(p[k], q[k], true);
+        out[k] = magnitudes ? static_cast<int32_t>(abs32(v)) : v;
+    }
 }
 
 // |p - q| for two points of the plane, um.
 __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
     uint32_t v[2];
-    int32_t* d = reinterpret_cast<int32_t*>(v);
-    sub2(d, p, q);
-    for (uint8_t k = 0; k < 2; ++k) v[k] = abs32(d[k]);
+    sub2(reinterpret_cast<int32_t*>(v), p, q, true);
     return sum_squares(v, 2).sqrt();
 }
 
@@ -429,9 +426,9 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
         // The control polygon start, a, b, end: points 0 2 3 1 of the row, 2 bits each.
         for (uint8_t seq = 0x1E, prev = 0; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
             uint8_t i = seq & 3;
-            int32_t d[2];
-            sub2(d, row + 2 * i, row + 2 * prev);
-            reach.add(Num(abs32(d[0]))).add(Num(abs32(d[1])));
+            uint32_t d[2];
+            sub2(reinterpret_cast<int32_t*>(d), row + 2 * i, row + 2 * prev, true);
+            reach.add(Num(d[0])).add(Num(d[1]));
             prev = i;
         }
     } else {
