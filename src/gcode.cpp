@@ -329,6 +329,11 @@ __attribute__((noinline)) bool length(uint8_t word, int32_t& out) {
     return num::length_to_milli(work().b.v[word].d, work().b.g[kGroupUnits] != 0, out);
 }
 
+// um along axis a to steps, rounded (false when out of the int32 range).
+__attribute__((noinline)) bool to_steps(int32_t um, uint8_t a, int32_t& steps) {
+    return num::mul_div_round(um, g_settings.axis[a].steps_per_unit, 1000000u, steps);
+}
+
 // a + b, or a - b with `subtract`; an overflow sets Block::overflow (checked once per line:
 // error:33). Bit 31 of (a ^ r) & (b' ^ r) is the signed overflow of r = a + b'.
 __attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = false) {
@@ -413,9 +418,10 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
     uint32_t spu_min = 0xFFFFFFFFu;
     for (uint8_t i = 0; i < 8; ++i) {
         int32_t steps;
-        uint32_t spu = g_settings.axis[ax[i & 1]].steps_per_unit;
+        uint8_t a = ax[i & 1];
+        uint32_t spu = g_settings.axis[a].steps_per_unit;
         if (spu < spu_min) spu_min = spu;
-        if (!num::mul_div_round(row[i], spu, 1000000u, steps) || abs32(steps) > (1l << 22)) {
+        if (!to_steps(row[i], a, steps) || abs32(steps) > (1l << 22)) {
             return false;
         }
     }
@@ -729,7 +735,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
             // Always from the absolute target: no rounding error accumulates. One move travels
             // at most kMaxLineTicks steps per axis (line.h).
             if (!offsets &&
-                (!num::mul_div_round(t, g_settings.axis[a].steps_per_unit, 1000000u, ra[0]) ||
+                (!to_steps(t, a, ra[0]) ||
                  abs32(static_cast<int32_t>(static_cast<uint32_t>(ra[0]) -
                                             static_cast<uint32_t>(sa[kAxes]))) > kMaxLineTicks)) {
                 b.overflow = 1;
@@ -839,8 +845,7 @@ void sync_position() {
 void settings_changed() {
     for (uint8_t a = 0; a < kAxes; ++a) {
         int32_t steps;
-        if (num::mul_div_round(g_state.position[a], g_settings.axis[a].steps_per_unit, 1000000u,
-                               steps)) {
+        if (to_steps(g_state.position[a], a, steps)) {
             g_state.position_steps[a] = steps;
         }
     }
