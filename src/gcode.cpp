@@ -367,20 +367,21 @@ void set_end_modes(Modal& m) {
     m.coolant = 9;
 }
 
-// p - q for two points of the plane (an overflow flags the block, as add() does), or with
-// `magnitudes` |p - q| per coordinate (as uint32_t: 2^31 for INT32_MIN).
-__attribute__((noinline)) void sub2(int32_t out[2], const int32_t p[2], const int32_t q[2],
-                                    bool magnitudes = false) {
+// Two points of the plane combined per coordinate: p - q, |p - q| (kMagnitudes, as uint32_t: 2^31
+// for INT32_MIN) or p + q (kSum). An overflow flags the block, as add() does.
+enum Op2 : uint8_t { kDifference, kMagnitudes, kSum };
+__attribute__((noinline)) void combine2(int32_t out[2], const int32_t p[2], const int32_t q[2],
+                                        uint8_t op = kDifference) {
     for (uint8_t k = 0; k < 2; ++k) {
-        int32_t v = add(p[k], q[k], true);
-        out[k] = magnitudes ? static_cast<int32_t>(abs32(v)) : v;
+        int32_t v = add(p[k], q[k], op != kSum);
+        out[k] = op == kMagnitudes ? static_cast<int32_t>(abs32(v)) : v;
     }
 }
 
 // |p - q| for two points of the plane, um.
 __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
     uint32_t v[2];
-    sub2(reinterpret_cast<int32_t*>(v), p, q, true);
+    combine2(reinterpret_cast<int32_t*>(v), p, q, kMagnitudes);
     return sum_squares(v, 2).sqrt();
 }
 
@@ -433,7 +434,7 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
         for (uint8_t seq = 0x1E, prev = 0; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
             uint8_t i = seq & 3;
             uint32_t d[2];
-            sub2(reinterpret_cast<int32_t*>(d), row + 2 * i, row + 2 * prev, true);
+            combine2(reinterpret_cast<int32_t*>(d), row + 2 * i, row + 2 * prev, kMagnitudes);
             reach.add(Num(d[0])).add(Num(d[1]));
             prev = i;
         }
@@ -444,7 +445,7 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
         int32_t cs[4];
         for (uint8_t e = 0; e < 2; ++e) {
             int32_t p[2];
-            sub2(p, row + 2 * e, c.a_um);
+            combine2(p, row + 2 * e, c.a_um);
             int32_t* cse = &cs[2 * (e ^ c.clockwise)];
             ellipse_direction(p[0], p[1], radii, cse[0], cse[1]);
             for (uint8_t k = 0; k < 2; ++k) {
@@ -496,7 +497,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     pick2(c.start_um, st.position, ax);
     pick2(c.end_um, work().req.target_um, ax);
     int32_t d[2]; // end - start
-    sub2(d, c.end_um, c.start_um);
+    combine2(d, c.end_um, c.start_um);
     bool has_offsets = ((b.words >> kWordI) & in_plane) != 0; // I J K are X Y Z's offsets
     bool has_pq = (b.words & bit(kWordP)) && (b.words & bit(kWordQ));
     const WordMask ijk = bit(kWordI) | bit(kWordJ) | bit(kWordK);
@@ -556,10 +557,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         }
     }
     // a = start + the offsets; a G5's b = end + P Q (start, end: a row of 4 too).
-    const int32_t* const ends = c.start_um;
-    for (uint8_t k = 0; k < 4; ++k) {
-        if (k < 2 || bezier) o[k] = add(ends[k], o[k]);
-    }
+    combine2(o, c.start_um, o, kSum);
+    if (bezier) combine2(o + 2, c.end_um, o + 2, kSum);
     // (An ellipse's ends are checked in curve_in_range().)
     if (!ellipse && !bezier) {
         if (!(b.words & bit(kWordR))) {
@@ -804,7 +803,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         // A G5 without I J continues the last G5 smoothly: remember its second arm.
         st.g5_continues = motion == Motion::Bezier;
         if (st.g5_continues) {
-            sub2(st.g5_reflect, b.curve.end_um, b.curve.b_um);
+            combine2(st.g5_reflect, b.curve.end_um, b.curve.b_um);
         }
         copy_words(st.position, req.target_um, kAxes);
         copy_words(st.position_steps, req.target_steps, kAxes);
