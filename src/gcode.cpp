@@ -672,7 +672,8 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         !(motion == Motion::Bezier && b.axis_command == kAxisMotion)) {
         return kNegativeValue;
     }
-    if ((b.words & bit(kWordN)) && b.n == kNoLineNumber) return kInvalidLineNumber;
+    // (N is 0 without the word, at most 10000000 when valid, else kNoLineNumber: its top bit.)
+    if (b.n >> 31) return kInvalidLineNumber;
 
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
     if (b.words & bit(kWordF)) {
