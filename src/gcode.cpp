@@ -455,8 +455,8 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
         }
     }
     // A circle's ends are checked in check_curve().
-    uint32_t gap_um = ellipse ? 1000000ul / spu_min + 2 : 0xFFFFFFFFu;
-    Num reach{}; // length bound, um
+    uint32_t gap_um = 1000000ul / spu_min + 2; // (an ellipse's; spu > 0: $100.. refuse 0)
+    Num reach{};                               // length bound, um
     if (c.kind == kCurveBezier) {
         // The control polygon start, a, b, end: points 0 2 3 1 of the row, 2 bits each.
         for (uint8_t seq = 0x1E, prev = 0; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
@@ -482,7 +482,7 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
                 uint32_t d = static_cast<uint32_t>(p[k]);
                 if (cse[k] < 0) d = 0u - d;
                 d -= on;
-                if (abs32(static_cast<int32_t>(d)) > gap_um) return false;
+                if (ellipse && abs32(static_cast<int32_t>(d)) > gap_um) return false;
             }
         }
         int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], false, c.turns);
