@@ -526,7 +526,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     pick2(c.end_um, work().req.target_um, ax);
     int32_t d[2]; // end - start
     combine2(d, c.end_um, c.start_um);
-    bool has_offsets = ((b.words >> kWordI) & in_plane) != 0; // I J K are X Y Z's offsets
+    bool has_offsets = (b.words & (WordMask(in_plane) << kWordI)) != 0; // I J K: X Y Z's
     bool has_pq = (~b.words & (bit(kWordP) | bit(kWordQ))) == 0;
     const WordMask ijk = bit(kWordI) | bit(kWordJ) | bit(kWordK);
     WordMask used = static_cast<WordMask>(ijk | bit(kWordP) | bit(kWordQ)); // G2.1, G3.1, G5
