@@ -502,7 +502,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     const uint8_t plane = c.plane = b.g[kGroupPlane];
     axes_of(plane, ax);
     // The normal of plane p is axis 2 - p (plane_axes), so the plane's axes are X Y Z but it.
-    const uint8_t in_plane = static_cast<uint8_t>(7u ^ (4u >> plane));
+    // (7 ^ (4 >> plane): 3, 5, 6, computed without a shift loop)
+    const uint8_t in_plane = static_cast<uint8_t>(3 + 2 * plane - (plane >> 1));
     // A curve moves the plane's axes and, along a helix, the normal one: not the others.
     if (axes & ~7u) return kAxisWordsExist;
     bool ellipse = motion == Motion::EllipseCw || motion == Motion::EllipseCcw;
