@@ -415,9 +415,10 @@ __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
 
 // plane_axes() as a rotation: (u, v, w) = axes (k - plane) mod 3.
 __attribute__((noinline)) void axes_of(uint8_t plane, uint8_t ax[3]) {
-    for (uint8_t k = 0, a = static_cast<uint8_t>(plane ? 3 - plane : 0); k < 3; ++k) {
-        ax[k] = a;
-        a = a == 2 ? 0 : static_cast<uint8_t>(a + 1);
+    uint8_t a = static_cast<uint8_t>(3 - plane); // 3 for G17: wraps to 0 at once
+    for (uint8_t k = 3; k != 0; --k) {
+        if (a == 3) a = 0;
+        *ax++ = a++;
     }
 }
 
