@@ -136,13 +136,13 @@ enum Word : uint8_t {
     kWordK,
     kWordQ,
     kWordR,
+    kWordS,
     kWordN,
     kWordL,
-    kWordS,
     kWordT,
     kWordCount
 };
-static_assert(kWordS > kWordN && kWordT == kWordCount - 1, "N L S T last");
+static_assert(kWordS < kWordN && kWordT == kWordL + 1 && kWordT == kWordCount - 1, "S, N L T last");
 constexpr uint8_t kDecimalSlots = kWordR + 1;
 constexpr uint8_t kLetterG = 0xFD, kLetterM = 0xFE, kLetterNone = 0xFF;
 
@@ -196,9 +196,9 @@ struct Block {
     uint8_t axis_command;
     uint8_t overflow; // an offset or target does not fit an int32 (see add())
     uint8_t l;        // L, 0xFF when not an integer 0..254
-    uint8_t tool;
-    uint16_t groups; // modal groups commanded in this block
-    WordMask words;  // value words present, bit(Word)
+    uint8_t tool;     // T (l and tool in a row, as kWordL and kWordT)
+    uint16_t groups;  // modal groups commanded in this block
+    WordMask words;   // value words present, bit(Word)
     // As State::feed, spindle_speed and line_number (copied as one).
     uint32_t feed;
     uint32_t s;
@@ -213,6 +213,7 @@ struct Block {
 };
 static_assert(sizeof(CurveParams) <= kWordP * sizeof(Slot),
               "the curve overlays the axis and F slots only");
+static_assert(offsetof(Block, tool) == offsetof(Block, l) + 1, "L and T in a row");
 static_assert(offsetof(Block, n) - offsetof(Block, feed) ==
                   offsetof(State, line_number) - offsetof(State, feed),
               "feed, S and N are laid out as in State");
@@ -283,7 +284,10 @@ uint8_t import_command(Block& b, uint8_t m, const num::Decimal& d) {
     // As GRBL: the axis-word conflict is checked before the decimal and the modal group.
     if (value & kUsesAxes) {
         if (b.axis_command != kAxisNone) return kAxisCommandConflict;
-        b.axis_command = group == kGroupMotion ? kAxisMotion : kAxisNonModal;
+        // (Only the motion and the non-modal group's commands use axes.)
+        static_assert(kGroupNonModal + 1 == kAxisNonModal && kGroupMotion + 1 == kAxisMotion,
+                      "the axis command of a group is its number + 1");
+        b.axis_command = static_cast<uint8_t>(group + 1);
     }
     if (!found) return kCommandValueNotInteger;
     uint16_t gbit = static_cast<uint16_t>(1u << group);
@@ -306,16 +310,14 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
     } else if (word >= kWordN) { // N L T (the last words)
         // N 0..10000000 and L 0..254 (else checked in stage 3), T 0..255.
         uint32_t v;
-        if (!num::to_uint(d, word == kWordN ? 10000000u : word == kWordL ? 254u : 255u, v)) {
+        if (!num::to_uint(d, word == kWordN ? 10000000u : 254u + word - kWordL, v)) {
             if (word == kWordT) return d.integral() ? kMaxValueExceeded : kCommandValueNotInteger;
             v = kNoLineNumber; // for L: 0xFF
         }
         if (word == kWordN) {
             b.n = v;
-        } else if (word == kWordL) {
-            b.l = static_cast<uint8_t>(v);
         } else {
-            b.tool = static_cast<uint8_t>(v);
+            (&b.l)[word - kWordL] = static_cast<uint8_t>(v); // L, T: Block::l, tool
         }
     }
     return kOk;
@@ -327,14 +329,47 @@ __attribute__((noinline)) bool length(uint8_t word, int32_t& out) {
     return num::length_to_milli(work().b.v[word].d, work().b.g[kGroupUnits] != 0, out);
 }
 
+// um along axis a to steps, rounded (false when out of the int32 range).
+__attribute__((noinline)) bool to_steps(int32_t um, uint8_t a, int32_t& steps) {
+    return num::mul_div_round(um, g_settings.axis[a].steps_per_unit, 1000000u, steps);
+}
+
 // a + b, or a - b with `subtract`; an overflow sets Block::overflow (checked once per line:
-// error:33). Bit 31 of (a ^ r) & (b' ^ r) is the signed overflow of r = a + b'.
+// error:33).
 __attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = false) {
+#if defined(__AVR__)
+    // The chip's add/adc or sub/sbc chain, whose V flag is the signed overflow: the function
+    // takes 44 bytes and about 25 cycles, the portable test below 100 bytes and about 50. (The
+    // simavr checks run it: fw_test_*.)
+    uint8_t v = 0;
+    asm("cpse %[s], __zero_reg__\n\t"
+        "rjmp 1f\n\t"
+        "add %A[a], %A[b]\n\t"
+        "adc %B[a], %B[b]\n\t"
+        "adc %C[a], %C[b]\n\t"
+        "adc %D[a], %D[b]\n\t"
+        "rjmp 2f\n"
+        "1:\n\t"
+        "sub %A[a], %A[b]\n\t"
+        "sbc %B[a], %B[b]\n\t"
+        "sbc %C[a], %C[b]\n\t"
+        "sbc %D[a], %D[b]\n"
+        "2:\n\t"
+        "brvc 3f\n\t"
+        "inc %[v]\n"
+        "3:"
+        : [a] "+r"(a), [v] "+r"(v)
+        : [b] "r"(b), [s] "r"(subtract));
+    if (v) work().b.overflow = 1;
+    return a;
+#else
+    // Bit 31 of (a ^ r) & (b' ^ r) is the signed overflow of r = a + b'.
     uint32_t ua = static_cast<uint32_t>(a), ub = static_cast<uint32_t>(b);
     if (subtract) ub = ~ub; // a - b = a + ~b + 1, and overflows as a + ~b would
     uint32_t r = ua + ub + subtract;
     if (((ua ^ r) & (ub ^ r)) >> 31) work().b.overflow = 1;
     return static_cast<int32_t>(r);
+#endif
 }
 
 // Copies `words` 32-bit words: 4 cycles a byte on the AVR, against 7 for memcpy's byte loop.
@@ -360,24 +395,39 @@ void set_end_modes(Modal& m) {
     m.coolant = 9;
 }
 
-// p - q for two points of the plane (an overflow flags the block, as add() does).
-__attribute__((noinline)) void sub2(int32_t out[2], const int32_t p[2], const int32_t q[2]) {
-#if defined(__AVR__)
-    // r17 marked as used: with it the saved registers are one run (r10..r17, r28, r29), which
-    // -mcall-prologues saves through its shared routines, not 9 pushes and pops (-16 B; 2 B of
-    // stack, about 25 cycles a call, a few calls a curve block).
-    asm volatile("" ::: "r17");
-#endif
-    for (uint8_t k = 0; k < 2; ++k) out[k] = add(p[k], q[k], true);
+// Two points of the plane combined per coordinate: p - q, |p - q| (kMagnitudes, as uint32_t: 2^31
+// for INT32_MIN) or p + q (kSum). An overflow flags the block, as add() does.
+enum Op2 : uint8_t { kDifference, kMagnitudes, kSum };
+__attribute__((noinline)) void combine2(int32_t out[2], const int32_t p[2], const int32_t q[2],
+                                        uint8_t op = kDifference) {
+    for (uint8_t k = 0; k < 2; ++k) {
+        int32_t v = add(p[k], q[k], op != kSum);
+        out[k] = op == kMagnitudes ? static_cast<int32_t>(abs32(v)) : v;
+    }
 }
 
 // |p - q| for two points of the plane, um.
 __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
     uint32_t v[2];
-    int32_t* d = reinterpret_cast<int32_t*>(v);
-    sub2(d, p, q);
-    for (uint8_t k = 0; k < 2; ++k) v[k] = abs32(d[k]);
+    combine2(reinterpret_cast<int32_t*>(v), p, q, kMagnitudes);
     return sum_squares(v, 2).sqrt();
+}
+
+// plane_axes() as a rotation: (u, v, w) = axes (k - plane) mod 3.
+__attribute__((noinline)) void axes_of(uint8_t plane, uint8_t ax[3]) {
+    uint8_t a = static_cast<uint8_t>(3 - plane); // 3 for G17: wraps to 0 at once
+    for (uint8_t k = 3; k != 0; --k) {
+        if (a == 3) a = 0;
+        *ax++ = a++;
+    }
+}
+
+// out = the coordinates of `from` along the plane's axes ax[0], ax[1].
+__attribute__((noinline)) void pick2(int32_t out[2], const int32_t* from, const uint8_t ax[2]) {
+    for (uint8_t k = 2; k != 0; --k) {
+        asm("" : "+r"(k)); // a loop: unrolled, the two copies take 78 B
+        *out++ = from[*ax++];
+    }
 }
 
 // The step generator's fixed-point range (docs/curves.md): the ends, the control points or the
@@ -387,8 +437,9 @@ __attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
 // each coordinate that close to the ellipse's point that has the same direction in the
 // ellipse's own scale (ellipse_direction). (A function of its own, called by execute() after
 // check_curve(): a small stack frame, not on top of check_curve()'s.)
-__attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_t ax[3],
-                                              bool ellipse) {
+__attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse) {
+    uint8_t ax[3];
+    axes_of(c.plane, ax);
     static_assert(offsetof(CurveParams, end_um) == offsetof(CurveParams, start_um) + 8 &&
                       offsetof(CurveParams, a_um) == offsetof(CurveParams, start_um) + 16 &&
                       offsetof(CurveParams, b_um) == offsetof(CurveParams, start_um) + 24,
@@ -397,41 +448,47 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, const uint8_
     uint32_t spu_min = 0xFFFFFFFFu;
     for (uint8_t i = 0; i < 8; ++i) {
         int32_t steps;
-        uint32_t spu = g_settings.axis[ax[i & 1]].steps_per_unit;
+        uint8_t a = ax[i & 1];
+        uint32_t spu = g_settings.axis[a].steps_per_unit;
         if (spu < spu_min) spu_min = spu;
-        if (!num::mul_div_round(row[i], spu, 1000000u, steps) || abs32(steps) > (1l << 22)) {
+        if (!to_steps(row[i], a, steps) || abs32(steps) > (1l << 22)) {
             return false;
         }
     }
     // A circle's ends are checked in check_curve().
-    uint32_t gap_um = ellipse ? 1000000ul / spu_min + 2 : 0xFFFFFFFFu;
-    Num reach{}; // length bound, um
+    uint32_t gap_um = 1000000ul / spu_min + 2; // (an ellipse's; spu > 0: $100.. refuse 0)
+    Num reach{};                               // length bound, um
     if (c.kind == kCurveBezier) {
         // The control polygon start, a, b, end: points 0 2 3 1 of the row, 2 bits each.
         for (uint8_t seq = 0x1E, prev = 0; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
             uint8_t i = seq & 3;
-            int32_t d[2];
-            sub2(d, row + 2 * i, row + 2 * prev);
-            reach.add(Num(abs32(d[0]))).add(Num(abs32(d[1])));
+            uint32_t d[2];
+            combine2(reinterpret_cast<int32_t*>(d), row + 2 * i, row + 2 * prev, kMagnitudes);
+            reach.add(Num(d[0])).add(Num(d[1]));
             prev = i;
         }
     } else {
         const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
+        // The ends' directions, the end first for a clockwise arc: its sweep is then the
+        // counter-clockwise one from the end to the start (sweep_q29 swaps them so), >= 0.
         int32_t cs[4];
         for (uint8_t e = 0; e < 2; ++e) {
             int32_t p[2];
-            sub2(p, row + 2 * e, c.a_um);
-            int32_t* cse = &cs[2 * e];
+            combine2(p, row + 2 * e, c.a_um);
+            int32_t* cse = &cs[2 * (e ^ c.clockwise)];
             ellipse_direction(p[0], p[1], radii, cse[0], cse[1]);
             for (uint8_t k = 0; k < 2; ++k) {
                 uint32_t on = Num(abs32(cse[k]), -30).mul(radii[k]).u32(); // r |cs| (Q30)
-                uint32_t d = static_cast<uint32_t>(p[k]) - (cse[k] < 0 ? 0u - on : on);
-                if (abs32(static_cast<int32_t>(d)) > gap_um) return false;
+                // p - sign(cs) on, as sign(cs) (sign(cs) p - on): the same magnitude.
+                uint32_t d = static_cast<uint32_t>(p[k]);
+                if (cse[k] < 0) d = 0u - d;
+                d -= on;
+                if (ellipse && abs32(static_cast<int32_t>(d)) > gap_um) return false;
             }
         }
-        int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], c.clockwise != 0, c.turns);
-        // |sweep| < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r |sweep|.
-        uint32_t q21 = static_cast<uint32_t>((sweep < 0 ? -sweep : sweep) >> 8);
+        int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], false, c.turns);
+        // 0 <= sweep < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r sweep.
+        uint32_t q21 = static_cast<uint32_t>(sweep >> 8);
         reach.set(q21, -21).mul(radii[0] > radii[1] ? radii[0] : radii[1]);
     }
     reach.add(Num(abs32(add(work().req.target_um[ax[2]], g_state.position[ax[2]], true))));
@@ -444,13 +501,10 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
                                               const State& st, CurveParams& c) {
     uint8_t ax[3];
     const uint8_t plane = c.plane = b.g[kGroupPlane];
-    // plane_axes() as a rotation: (u, v, w) = axes (k - plane) mod 3.
-    for (uint8_t k = 0, a = static_cast<uint8_t>(plane ? 3 - plane : 0); k < 3; ++k) {
-        ax[k] = a;
-        a = a == 2 ? 0 : static_cast<uint8_t>(a + 1);
-    }
+    axes_of(plane, ax);
     // The normal of plane p is axis 2 - p (plane_axes), so the plane's axes are X Y Z but it.
-    const uint8_t in_plane = static_cast<uint8_t>(7u ^ (4u >> plane));
+    // (7 ^ (4 >> plane): 3, 5, 6, computed without a shift loop)
+    const uint8_t in_plane = static_cast<uint8_t>(3 + 2 * plane - (plane >> 1));
     // A curve moves the plane's axes and, along a helix, the normal one: not the others.
     if (axes & ~7u) return kAxisWordsExist;
     bool ellipse = motion == Motion::EllipseCw || motion == Motion::EllipseCcw;
@@ -463,19 +517,19 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     // o: the plane's offsets (I J, I K or J K), then P and Q, in um; kept in c.a_um and c.b_um
     // (a row of 4: checked in curve_in_range) until they become the points.
     int32_t* const o = c.a_um;
+    bool pq_not_positive = false; // an ellipse's semi-axes must be above 0
     for (uint8_t k = 0; k < 4; ++k) {
         uint8_t word = static_cast<uint8_t>(k < 2 ? kWordI + ax[k] : k == 2 ? kWordP : kWordQ);
         o[k] = 0;
         if ((b.words & bit(word)) && !length(word, o[k])) return kBadNumberFormat;
-        if (k < 2) {
-            c.start_um[k] = st.position[ax[k]];
-            c.end_um[k] = work().req.target_um[ax[k]];
-        }
+        if (k >= 2 && o[k] <= 0) pq_not_positive = true;
     }
+    pick2(c.start_um, st.position, ax);
+    pick2(c.end_um, work().req.target_um, ax);
     int32_t d[2]; // end - start
-    sub2(d, c.end_um, c.start_um);
-    bool has_offsets = ((b.words >> kWordI) & in_plane) != 0; // I J K are X Y Z's offsets
-    bool has_pq = (b.words & bit(kWordP)) && (b.words & bit(kWordQ));
+    combine2(d, c.end_um, c.start_um);
+    bool has_offsets = (b.words & (WordMask(in_plane) << kWordI)) != 0; // I J K: X Y Z's
+    bool has_pq = (~b.words & (bit(kWordP) | bit(kWordQ))) == 0;
     const WordMask ijk = bit(kWordI) | bit(kWordJ) | bit(kWordK);
     WordMask used = static_cast<WordMask>(ijk | bit(kWordP) | bit(kWordQ)); // G2.1, G3.1, G5
     uint32_t r = 0;
@@ -492,9 +546,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         // axes; both ends on the ellipse within one tick + 0.002 mm (in curve_in_range()).
         if (!has_offsets) return kNoOffsetsInPlane;
         if (!has_pq) return kValueWordMissing;
-        for (uint8_t k = 2; k < 4; ++k) {
-            if (o[k] <= 0) return kNegativeValue;
-        }
+        if (pq_not_positive) return kNegativeValue;
     } else {
         // G2 / G3, as GRBL: radius mode (R) or centre mode (the plane's offsets).
         used = bit(kWordP);
@@ -522,7 +574,10 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             for (uint8_t k = 0; k < 2; ++k) {
                 int32_t t = static_cast<int32_t>(h.of(abs32(d[1 - k])));
                 if ((d[1 - k] < 0) != neg) t = -t;
-                o[k] = (d[k] + t) / 2;
+                // (d[k] + t) / 2, rounded toward zero as the division would be (without the
+                // library's 32-bit division: the sign bit added, then an arithmetic shift).
+                uint32_t sum = static_cast<uint32_t>(d[k]) + static_cast<uint32_t>(t);
+                o[k] = static_cast<int32_t>(sum + (sum >> 31)) >> 1;
                 neg = !neg;
             }
         } else if (!has_offsets) {
@@ -532,10 +587,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         }
     }
     // a = start + the offsets; a G5's b = end + P Q (start, end: a row of 4 too).
-    const int32_t* const ends = c.start_um;
-    for (uint8_t k = 0; k < 4; ++k) {
-        if (k < 2 || bezier) o[k] = add(ends[k], o[k]);
-    }
+    combine2(o, c.start_um, o, kSum);
+    if (bezier) combine2(o + 2, c.end_um, o + 2, kSum);
     // (An ellipse's ends are checked in curve_in_range().)
     if (!ellipse && !bezier) {
         if (!(b.words & bit(kWordR))) {
@@ -621,7 +674,8 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         !(motion == Motion::Bezier && b.axis_command == kAxisMotion)) {
         return kNegativeValue;
     }
-    if ((b.words & bit(kWordN)) && b.n == kNoLineNumber) return kInvalidLineNumber;
+    // (N is 0 without the word, at most 10000000 when valid, else kNoLineNumber: its top bit.)
+    if (b.n >> 31) return kInvalidLineNumber;
 
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
     if (b.words & bit(kWordF)) {
@@ -643,10 +697,8 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
 
     // [19] The axis words in um, then the non-modal commands that use them, or the target.
     for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
-        if (!(m & 1)) continue;
-        int32_t um;
-        if (!length(a, um)) return kBadNumberFormat;
-        b.v[a].um = um;
+        // In place: length_to_milli() has read the number when it writes the um.
+        if ((m & 1) && !length(a, b.v[a].um)) return kBadNumberFormat;
     }
     // One pass over the axes computes either the new offsets (G10, G92) or the target of a
     // move: an axis without a word keeps `keep`, an axis with a word gets its value, turned
@@ -713,7 +765,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
             // Always from the absolute target: no rounding error accumulates. One move travels
             // at most kMaxLineTicks steps per axis (line.h).
             if (!offsets &&
-                (!num::mul_div_round(t, g_settings.axis[a].steps_per_unit, 1000000u, ra[0]) ||
+                (!to_steps(t, a, ra[0]) ||
                  abs32(static_cast<int32_t>(static_cast<uint32_t>(ra[0]) -
                                             static_cast<uint32_t>(sa[kAxes]))) > kMaxLineTicks)) {
                 b.overflow = 1;
@@ -734,9 +786,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
             if (r != kOk) return r;
             // Called here rather than under check_curve()'s frame: it reaches
             // ellipse_direction(), the deepest stack of a G-code line.
-            uint8_t ax[3];
-            plane_axes(b.curve.plane, ax);
-            if (!curve_in_range(b.curve, ax, ellipse)) return kInvalidTarget;
+            if (!curve_in_range(b.curve, ellipse)) return kInvalidTarget;
             curve = true;
         } else if (axes == 0) {
             b.axis_command = kAxisNone; // G0/G1 alone: a mode change only
@@ -784,7 +834,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         // A G5 without I J continues the last G5 smoothly: remember its second arm.
         st.g5_continues = motion == Motion::Bezier;
         if (st.g5_continues) {
-            sub2(st.g5_reflect, b.curve.end_um, b.curve.b_um);
+            combine2(st.g5_reflect, b.curve.end_um, b.curve.b_um);
         }
         copy_words(st.position, req.target_um, kAxes);
         copy_words(st.position_steps, req.target_steps, kAxes);
@@ -825,8 +875,7 @@ void sync_position() {
 void settings_changed() {
     for (uint8_t a = 0; a < kAxes; ++a) {
         int32_t steps;
-        if (num::mul_div_round(g_state.position[a], g_settings.axis[a].steps_per_unit, 1000000u,
-                               steps)) {
+        if (to_steps(g_state.position[a], a, steps)) {
             g_state.position_steps[a] = steps;
         }
     }
