@@ -211,6 +211,11 @@ void feed_hold() {
 }
 
 void cycle_start() {
+#if defined(__AVR__)
+    // Y marked as used: with it the saved registers are one run (r8..r17, r28, r29), which
+    // -mcall-prologues saves through its shared routines, not 10 pushes and pops.
+    asm volatile("" ::: "r28", "r29");
+#endif
     Motion& m = mo();
     if (m.state != State::Held) return;
     if (m.begun && m.gen.stopped()) {
