@@ -156,6 +156,11 @@ void save_coord(const int32_t (&um)[kAxes]) {
 }
 
 uint8_t store(uint8_t n, const num::Decimal& value) {
+#if defined(__AVR__)
+    // r16 marked as used: with it the saved registers are one run (r12..r17, r28, r29), which
+    // -mcall-prologues saves through its shared routines, not 7 pushes and pops.
+    asm volatile("" ::: "r16");
+#endif
     if (value.negative()) return status::kNegativeValue;
     uint8_t kind;
     uint8_t* f = find(n, kind);
