@@ -162,11 +162,6 @@ void save_coord(const int32_t (&um)[kAxes]) {
 }
 
 uint8_t store(uint8_t n, const num::Decimal& value) {
-#if defined(__AVR__)
-    // r16 marked as used: with it the saved registers are one run (r12..r17, r28, r29), which
-    // -mcall-prologues saves through its shared routines, not 7 pushes and pops.
-    asm volatile("" ::: "r16");
-#endif
     if (value.negative()) return status::kNegativeValue;
     const Found found = find(n);
     uint8_t* f = found.field;
