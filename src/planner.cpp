@@ -69,12 +69,13 @@ __attribute__((noinline)) uint32_t travel(const Machine& m, const int32_t delta[
     return at_least_1(sum_squares(x, kAxes, group).sqrt().u32());
 }
 
-// The smallest of a limit over the axes whose bit is set in `mask` (2^32 - 1 for none).
+// The smallest of a limit over the axes whose bit is set in `mask` (bits below kAxes only;
+// 2^32 - 1 for none). The loop ends with the mask: no counter, which leaves avr-gcc the
+// call-clobbered registers for the loaded limit (it pushed r12..r15 for it).
 __attribute__((noinline)) uint32_t min_over(const Machine& m, Limit which, uint8_t mask) {
     uint32_t v = 0xFFFFFFFFul;
-    const AxisSettings* ax = m.settings->axis;
-    for (uint8_t a = 0; a < kAxes; ++a, mask >>= 1) {
-        if (mask & 1) v = min32(v, ax[a].*which);
+    for (const AxisSettings* ax = m.settings->axis; mask != 0; ++ax, mask >>= 1) {
+        if (mask & 1) v = min32(v, ax->*which);
     }
     return v;
 }
