@@ -211,6 +211,11 @@ void feed_hold() {
 }
 
 void cycle_start() {
+#if defined(__AVR__)
+    // Y marked as used: with it the saved registers are one run (r8..r17, r28, r29), which
+    // -mcall-prologues saves through its shared routines, not 10 pushes and pops.
+    asm volatile("" ::: "r28", "r29");
+#endif
     Motion& m = mo();
     if (m.state != State::Held) return;
     if (m.begun && m.gen.stopped()) {
@@ -249,11 +254,12 @@ void position(int32_t steps[kAxes]) {
     // Undo what is queued but not executed: the rest of the current run, then every run
     // between the consumer and the producer.
     for (;;) {
-        for (uint8_t a = 0; a < kAxes; ++a, s >>= 1, d >>= 1) {
+        // Until no step bit is left (they are axis bits: bit kAxes and up are never set).
+        for (int32_t* p = steps; s != 0; ++p, s >>= 1, d >>= 1) {
             if (s & 1) {
                 int16_t dn = n;
                 if (!(d & 1)) dn = static_cast<int16_t>(-dn);
-                steps[a] += dn;
+                *p += dn;
             }
         }
         if (i == g_runs.tail) return;

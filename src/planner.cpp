@@ -69,12 +69,13 @@ __attribute__((noinline)) uint32_t travel(const Machine& m, const int32_t delta[
     return at_least_1(sum_squares(x, kAxes, group).sqrt().u32());
 }
 
-// The smallest of a limit over the axes whose bit is set in `mask` (2^32 - 1 for none).
+// The smallest of a limit over the axes whose bit is set in `mask` (bits below kAxes only;
+// 2^32 - 1 for none). The loop ends with the mask: no counter, which leaves avr-gcc the
+// call-clobbered registers for the loaded limit (it pushed r12..r15 for it).
 __attribute__((noinline)) uint32_t min_over(const Machine& m, Limit which, uint8_t mask) {
     uint32_t v = 0xFFFFFFFFul;
-    const AxisSettings* ax = m.settings->axis;
-    for (uint8_t a = 0; a < kAxes; ++a, mask >>= 1) {
-        if (mask & 1) v = min32(v, ax[a].*which);
+    for (const AxisSettings* ax = m.settings->axis; mask != 0; ++ax, mask >>= 1) {
+        if (mask & 1) v = min32(v, ax->*which);
     }
     return v;
 }
@@ -172,7 +173,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     q.e = static_cast<int8_t>(q.e - 60);
     // GRBL's thresholds: |cos theta| > 0.999999 is straight on (no limit) or a reversal
     // (stop), i.e. q or p below 5e-7.
-    if (tiny(q)) return 0xFFFFFFFFul;
+    if (tiny(q)) return limit;
     // Only min(junction, limit) matters. With p = 1 - q = sin^2 <= 1, sin (1 + sin) >= p >= 1/2
     // when q < 1/2 (q.e < -32), and the junction acceleration (limited per axis along d) is at
     // least the smallest axis acceleration of d, so
@@ -184,7 +185,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
         t.set(min_over(*m_, kAccel, moving)).mul(m_->junction_dev_um);
         r.set(limit).mul(q);
         r.e = static_cast<int8_t>(r.e + 10);
-        if (t.cmp(r) >= 0) return 0xFFFFFFFFul;
+        if (t.cmp(r) >= 0) return limit;
     }
     // The exact formula (rare in chains of short segments).
     // p = 1 - q to 2^-32: near a reversal (p small) its relative error grows to 2^-11 at the
@@ -204,7 +205,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     uint8_t a = tightest(ax, kAccel, dc);
     q.sqrt().mulc(k3_6, -16); // sqrt(q) 2^16 x 2^14 = |d| in Q29, x 3.6 (k3_6 2^-30)
     r.mul(at_least_1(t.set(ax[a].accel).div(dc[a]).mul(q).u32())).mul(m_->junction_dev_um);
-    return r.mulc(kMilli, -9).u32(); // / 1000 (kMilli 2^-41), x 2^32
+    return min32(r.mulc(kMilli, -9).u32(), limit); // / 1000 (kMilli 2^-41), x 2^32
 }
 
 bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) {
@@ -281,7 +282,7 @@ void Planner::finish_block(uint8_t group, uint8_t curve, uint32_t feed,
         const PlanBlock* prev = at(count_ - 1);
         if (static_cast<uint8_t>(prev->group) == group) {
             const uint32_t limit = speed2_of(min32(b.feed, prev->feed));
-            v2 = min32(junction2(unit_in, limit), limit);
+            v2 = junction2(unit_in, limit);
         }
     }
     b.v_max_entry2 = v2;

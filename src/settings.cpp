@@ -59,19 +59,25 @@ const Row kRows[] LL_PROGMEM = {
 #undef LL_ROW
 constexpr uint8_t kRowCount = sizeof(kRows) / sizeof(kRows[0]);
 
-// The field that holds `$n` and its kind; nullptr when no row has that number.
-uint8_t* find(uint8_t n, uint8_t& kind) {
+// The field that holds `$n` and its kind; field nullptr when no row has that number. Returned in
+// registers (r22..r24), not through a pointer: the callers then keep no frame for the kind.
+struct Found {
+    uint8_t* field;
+    uint8_t kind;
+};
+Found find(uint8_t n) {
     for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
         uint8_t first = flash_read_byte(&row->number);
         uint8_t a = static_cast<uint8_t>(n - first);
         uint8_t count = first >= kFirstAxisNumber ? kAxes : 1; // compared in 8 bits
         if (a >= count) continue;
-        kind = flash_read_byte(&row->kind);
+        const uint8_t kind = flash_read_byte(&row->kind);
         uint8_t stride = kind == kGroup ? 1 : sizeof(AxisSettings);
-        return reinterpret_cast<uint8_t*>(&g_settings) + flash_read_byte(&row->offset) +
-               static_cast<uint8_t>(a * stride);
+        return {reinterpret_cast<uint8_t*>(&g_settings) + flash_read_byte(&row->offset) +
+                    static_cast<uint8_t>(a * stride),
+                kind};
     }
-    return nullptr;
+    return {nullptr, 0};
 }
 
 // Fletcher-style 16-bit check over the record (two running 8-bit sums), computed while it is
@@ -157,8 +163,9 @@ void save_coord(const int32_t (&um)[kAxes]) {
 
 uint8_t store(uint8_t n, const num::Decimal& value) {
     if (value.negative()) return status::kNegativeValue;
-    uint8_t kind;
-    uint8_t* f = find(n, kind);
+    const Found found = find(n);
+    uint8_t* f = found.field;
+    const uint8_t kind = found.kind;
     if (f == nullptr) return status::kInvalidStatement;
     if (kind >= kMilli) {
         int32_t milli;
@@ -185,8 +192,9 @@ void report() {
     // this prints them in `$$` order without a second walk over the table.
     uint8_t n = 0;
     do {
-        uint8_t kind;
-        const uint8_t* f = find(n, kind);
+        const Found found = find(n);
+        const uint8_t* f = found.field;
+        const uint8_t kind = found.kind;
         if (f == nullptr) continue;
         out::ch('$');
         out::u8(n);

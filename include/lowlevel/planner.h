@@ -116,8 +116,8 @@ class Planner {
     /// The look-ahead passes (from the oldest move when it is not begun, else stopping where
     /// nothing changes any more).
     void recalculate();
-    /// Junction speed squared with the previous move, or any value >= `limit` when it is at
-    /// least that (the caller takes the minimum).
+    /// Junction speed squared with the previous move, at most `limit` (min(junction, limit):
+    /// the early outs return `limit` itself).
     uint32_t junction2(const int32_t unit[kAxes], uint32_t limit) const;
 
     /// Writes the move from the last target to `target` (steps) into `b` and `d`; `target`
