@@ -690,7 +690,7 @@ void usage() {
 
 } // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
     Config cfg;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -906,4 +906,14 @@ int main(int argc, char** argv) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     std::cerr << fmt("llbench: %.1f s of wall time\n", wall);
     return 0;
+}
+
+int main(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        // (e.g. no image: the AVR build failed or has not run)
+        std::cerr << "llbench: " << e.what() << "\n";
+        return 1;
+    }
 }
