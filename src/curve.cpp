@@ -2,6 +2,7 @@
 
 #include "lowlevel/fixmath.h"
 #include "lowlevel/pgm.h"
+#include "lowlevel/scratch.h"
 
 #include <string.h>
 
@@ -1003,8 +1004,18 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
 
 } // namespace
 
+// (Defined here, in the lowest module that uses it, so that linking the curves alone needs it
+// and nothing more.)
+alignas(alignof(void*)) uint8_t g_scratch[kScratchBytes]; // 1 on the AVR, 8 on the host
+
+// The track in the scratch RAM (scratch.h: dead there under push_line()), not in a 46-byte frame
+// on the deepest stack of the firmware.
+static_assert(sizeof(Track) <= kCurveTrackBytes && kCurveTrackAt % alignof(Track) == 0,
+              "the track fits its share of the scratch RAM");
 bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
-    Track k{}; // (out's tangents are written in full: unit_vector() gives 0 for a null vector)
+    Track& k = scratch<Track, kCurveTrackAt>();
+    memset(&k, 0, sizeof(k)); // (out's tangents are written in full: unit_vector() gives 0 for a
+                              // null vector)
     return shape(cp, dw_um, w_regulated && dw_um != 0, out, k);
 }
 
