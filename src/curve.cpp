@@ -301,14 +301,22 @@ __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& thir
     return neg;
 }
 
-// ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30.
-__attribute__((noinline)) void direction(const int32_t p[2], const int32_t centre[2],
-                                         const uint32_t radii[2], int32_t out[2]) {
-    const int32_t v[2] = {p[0] - centre[0], p[1] - centre[1]};
+// ellipse_direction() of the vector v, overwritten with (cos t, sin t), Q30. In place: no
+// vector and no result in the callers' frames (ellipse_direction() is on the deepest stack of a
+// G-code line).
+__attribute__((noinline)) void direction_of(int32_t v[2], const uint32_t radii[2]) {
     Num q[3];
-    const uint8_t neg = components(v, Num{}, q);
+    const uint8_t neg = components(v, Num{}, q); // (v is read here, then only written)
     for (uint8_t k = 0; k < 2; ++k) q[k].div(radii[k]);
-    unit_vector(q, 2, neg, 30, out);
+    unit_vector(q, 2, neg, 30, v);
+}
+
+// ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30.
+void direction(const int32_t p[2], const int32_t centre[2], const uint32_t radii[2],
+               int32_t out[2]) {
+    out[0] = p[0] - centre[0];
+    out[1] = p[1] - centre[1];
+    direction_of(out, radii);
 }
 
 // Directions (cos t, sin t) of an arc's start and end seen from its centre in the ellipse's
@@ -455,9 +463,8 @@ __attribute__((noinline)) int64_t add_turn(int64_t x) {
 
 void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], int32_t& c,
                        int32_t& s) {
-    const int32_t p[2] = {x_q8, y_q8}, zero[2] = {0, 0};
-    int32_t u[2];
-    direction(p, zero, radii_q8, u);
+    int32_t u[2] = {x_q8, y_q8};
+    direction_of(u, radii_q8);
     c = u[0];
     s = u[1];
 }
