@@ -311,9 +311,10 @@ __attribute__((noinline)) void direction_of(int32_t v[2], const uint32_t radii[2
     unit_vector(q, 2, neg, 30, v);
 }
 
-// ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30.
-void direction(const int32_t p[2], const int32_t centre[2], const uint32_t radii[2],
-               int32_t out[2]) {
+// ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30. (Not
+// inlined twice into arc_directions().)
+__attribute__((noinline)) void direction(const int32_t p[2], const int32_t centre[2],
+                                         const uint32_t radii[2], int32_t out[2]) {
     out[0] = p[0] - centre[0];
     out[1] = p[1] - centre[1];
     direction_of(out, radii);
@@ -898,7 +899,12 @@ void tangent(Track& k, int32_t out[3]) {
 // is kept in k.rmin when it is the smallest so far.
 Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
     save_run_from_r8();
-    int32_t d1[2], d2[2];
+    // P' and P'' in the scratch RAM (scratch.h: dead there under push_line()), not in a frame
+    // on the deepest stack of the firmware.
+    static_assert(4 * sizeof(int32_t) <= kCurveProbeBytes, "P' and P'' fit their share");
+    int32_t(&d)[4] = scratch<int32_t[4], kCurveProbeAt>();
+    int32_t* const d1 = d;
+    int32_t* const d2 = d + 2;
     track_at(k, off, move, d1, d2);
     Num n1 = norm(d1, k, false);
     if (k.bezier) {
@@ -923,7 +929,13 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
 // nearest singularity of |P'| in the complex plane is at least two widths away: 1e-7 relative),
 // and at most `widest`. On a Bezier, the radii of curvature are sampled at every node and panel
 // end, and these crowd where the curve turns tightly.
-Num track_length(Track& k, uint32_t span, uint32_t widest) {
+Num track_length(Track& track, uint32_t span, uint32_t widest) {
+    // The track's address as a pointer the callees cannot see through (it is a constant,
+    // scratch.h): probe() and track_at() then reach it with displacements from a pointer
+    // register (2 bytes an instruction), not at absolute addresses (lds/sts, 4 bytes).
+    Track* kp = &track;
+    asm("" : "+r"(kp));
+    Track& k = *kp;
     Num total{};
     uint32_t half, w = 0;
     for (;;) {
@@ -1020,7 +1032,8 @@ alignas(alignof(void*)) uint8_t g_scratch[kScratchBytes]; // 1 on the AVR, 8 on 
 static_assert(sizeof(Track) <= kCurveTrackBytes && kCurveTrackAt % alignof(Track) == 0,
               "the track fits its share of the scratch RAM");
 bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
-    Track& k = scratch<Track, kCurveTrackAt>();
+    Track* kp = &scratch<Track, kCurveTrackAt>();
+    Track& k = *kp;
     memset(&k, 0, sizeof(k)); // (out's tangents are written in full: unit_vector() gives 0 for a
                               // null vector)
     return shape(cp, dw_um, w_regulated && dw_um != 0, out, k);

@@ -239,6 +239,10 @@ static_assert(offsetof(Work, b) + offsetof(Block, v) + sizeof(CurveParams) <= kC
                   kCurveTrackAt + kCurveTrackBytes <= offsetof(Block, v) + sizeof(Block::v) &&
                   offsetof(Block, v) + sizeof(Block::v) <= offsetof(Work, req),
               "the curve track (scratch.h) overlays dead slots of the work block only");
+// And probe()'s derivatives its header, which execute() writes afresh from stage 1 on.
+static_assert(kCurveProbeAt + kCurveProbeBytes <= offsetof(Work, b) + offsetof(Block, v) &&
+                  kCurveProbeAt + kCurveProbeBytes <= kCurveTrackAt,
+              "the curve's derivatives (scratch.h) overlay the work block's header only");
 inline Work& work() {
     return motion::scratch<Work>();
 }

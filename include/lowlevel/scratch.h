@@ -21,6 +21,11 @@ extern uint8_t g_scratch[kScratchBytes];
 /// frame on the deepest stack of the firmware. gcode.cpp pins the layout.
 constexpr uint16_t kCurveTrackAt = sizeof(void*) == 2 ? 65 : 68;
 constexpr uint16_t kCurveTrackBytes = 52;
+/// Bytes [kCurveProbeAt, kCurveProbeAt + kCurveProbeBytes) are dead there too: the work block's
+/// header, which execute() writes afresh at its start and no one reads once it has returned.
+/// The curve's probe() keeps its derivatives there.
+constexpr uint16_t kCurveProbeAt = 0;
+constexpr uint16_t kCurveProbeBytes = 16;
 
 /// The scratch RAM from byte `at` as a T. Each user only ever accesses it as its own type, in
 /// its own translation unit, and the other users' accesses are behind a call: no access through
