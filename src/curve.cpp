@@ -2,6 +2,7 @@
 
 #include "lowlevel/fixmath.h"
 #include "lowlevel/pgm.h"
+#include "lowlevel/scratch.h"
 
 #include <string.h>
 
@@ -300,14 +301,23 @@ __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& thir
     return neg;
 }
 
-// ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30.
+// ellipse_direction() of the vector v, overwritten with (cos t, sin t), Q30. In place: no
+// vector and no result in the callers' frames (ellipse_direction() is on the deepest stack of a
+// G-code line).
+__attribute__((noinline)) void direction_of(int32_t v[2], const uint32_t radii[2]) {
+    Num q[3];
+    const uint8_t neg = components(v, Num{}, q); // (v is read here, then only written)
+    for (uint8_t k = 0; k < 2; ++k) q[k].div(radii[k]);
+    unit_vector(q, 2, neg, 30, v);
+}
+
+// ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30. (Not
+// inlined twice into arc_directions().)
 __attribute__((noinline)) void direction(const int32_t p[2], const int32_t centre[2],
                                          const uint32_t radii[2], int32_t out[2]) {
-    const int32_t v[2] = {p[0] - centre[0], p[1] - centre[1]};
-    Num q[3];
-    const uint8_t neg = components(v, Num{}, q);
-    for (uint8_t k = 0; k < 2; ++k) q[k].div(radii[k]);
-    unit_vector(q, 2, neg, 30, out);
+    out[0] = p[0] - centre[0];
+    out[1] = p[1] - centre[1];
+    direction_of(out, radii);
 }
 
 // Directions (cos t, sin t) of an arc's start and end seen from its centre in the ellipse's
@@ -454,9 +464,8 @@ __attribute__((noinline)) int64_t add_turn(int64_t x) {
 
 void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], int32_t& c,
                        int32_t& s) {
-    const int32_t p[2] = {x_q8, y_q8}, zero[2] = {0, 0};
-    int32_t u[2];
-    direction(p, zero, radii_q8, u);
+    int32_t u[2] = {x_q8, y_q8};
+    direction_of(u, radii_q8);
     c = u[0];
     s = u[1];
 }
@@ -890,7 +899,12 @@ void tangent(Track& k, int32_t out[3]) {
 // is kept in k.rmin when it is the smallest so far.
 Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
     save_run_from_r8();
-    int32_t d1[2], d2[2];
+    // P' and P'' in the scratch RAM (scratch.h: dead there under push_line()), not in a frame
+    // on the deepest stack of the firmware.
+    static_assert(4 * sizeof(int32_t) <= kCurveProbeBytes, "P' and P'' fit their share");
+    int32_t(&d)[4] = scratch<int32_t[4], kCurveProbeAt>();
+    int32_t* const d1 = d;
+    int32_t* const d2 = d + 2;
     track_at(k, off, move, d1, d2);
     Num n1 = norm(d1, k, false);
     if (k.bezier) {
@@ -915,7 +929,13 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
 // nearest singularity of |P'| in the complex plane is at least two widths away: 1e-7 relative),
 // and at most `widest`. On a Bezier, the radii of curvature are sampled at every node and panel
 // end, and these crowd where the curve turns tightly.
-Num track_length(Track& k, uint32_t span, uint32_t widest) {
+Num track_length(Track& track, uint32_t span, uint32_t widest) {
+    // The track's address as a pointer the callees cannot see through (it is a constant,
+    // scratch.h): probe() and track_at() then reach it with displacements from a pointer
+    // register (2 bytes an instruction), not at absolute addresses (lds/sts, 4 bytes).
+    Track* kp = &track;
+    asm("" : "+r"(kp));
+    Track& k = *kp;
     Num total{};
     uint32_t half, w = 0;
     for (;;) {
@@ -1003,8 +1023,19 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
 
 } // namespace
 
+// (Defined here, in the lowest module that uses it, so that linking the curves alone needs it
+// and nothing more.)
+alignas(alignof(void*)) uint8_t g_scratch[kScratchBytes]; // 1 on the AVR, 8 on the host
+
+// The track in the scratch RAM (scratch.h: dead there under push_line()), not in a 46-byte frame
+// on the deepest stack of the firmware.
+static_assert(sizeof(Track) <= kCurveTrackBytes && kCurveTrackAt % alignof(Track) == 0,
+              "the track fits its share of the scratch RAM");
 bool curve_shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out) {
-    Track k{}; // (out's tangents are written in full: unit_vector() gives 0 for a null vector)
+    Track* kp = &scratch<Track, kCurveTrackAt>();
+    Track& k = *kp;
+    memset(&k, 0, sizeof(k)); // (out's tangents are written in full: unit_vector() gives 0 for a
+                              // null vector)
     return shape(cp, dw_um, w_regulated && dw_um != 0, out, k);
 }
 

@@ -233,6 +233,16 @@ struct Work {
 // In the motion side's scratch RAM (motion.h: it is ours from execute() until push_line()).
 static_assert(sizeof(void*) != 2 || sizeof(Work) == motion::kScratchBytes,
               "motion::kScratchBytes is the size of the work block on the AVR");
+// Under push_line(), curve_shape() keeps its track in the slots past the curve (P I J K Q R,
+// read by check_curve() before the curve was written): only the curve and req are live then.
+static_assert(offsetof(Work, b) + offsetof(Block, v) + sizeof(CurveParams) <= kCurveTrackAt &&
+                  kCurveTrackAt + kCurveTrackBytes <= offsetof(Block, v) + sizeof(Block::v) &&
+                  offsetof(Block, v) + sizeof(Block::v) <= offsetof(Work, req),
+              "the curve track (scratch.h) overlays dead slots of the work block only");
+// And probe()'s derivatives its header, which execute() writes afresh from stage 1 on.
+static_assert(kCurveProbeAt + kCurveProbeBytes <= offsetof(Work, b) + offsetof(Block, v) &&
+                  kCurveProbeAt + kCurveProbeBytes <= kCurveTrackAt,
+              "the curve's derivatives (scratch.h) overlay the work block's header only");
 inline Work& work() {
     return motion::scratch<Work>();
 }

@@ -124,8 +124,6 @@ void restart(Motion& m, const int32_t here[kAxes]) {
 
 } // namespace
 
-alignas(alignof(void*)) uint8_t g_scratch[kScratchBytes]; // 1 on the AVR, 8 on the host
-
 void init() {
     int32_t* zero = here_scratch().steps;
     memset(zero, 0, sizeof(Here::steps));

@@ -4,6 +4,7 @@
 
 #include "lowlevel/config.h"
 #include "lowlevel/curve.h"
+#include "lowlevel/scratch.h"
 
 namespace ll {
 namespace motion {
@@ -26,22 +27,12 @@ struct LineRequest {
 /// on the deepest stack (the move handed over was a local of poll()). The status report
 /// (protocol.cpp) and the `$` commands, which run neither inside poll() nor inside execute() and
 /// poll nothing, keep their coordinates and numbers there too, as do init(), abort() and
-/// settings_changed().
-// The size of the G-code work block on the AVR (gcode.cpp checks it), generous on the host.
-constexpr uint16_t kScratchBytes =
-    sizeof(void*) == 2 ? 92 + 16 * kAxes + (kAxes > 5 ? 2 : 0) : 128 + 32 * kAxes;
-extern uint8_t g_scratch[kScratchBytes];
-/// The scratch RAM as a T. Each side only ever accesses it as its own type, in its own
-/// translation unit, and the other side's accesses are behind a call: no access through one
-/// type can be reordered across an access through the other (the -Wstrict-aliasing concern).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wstrict-aliasing"
-template <typename T>
-inline T& scratch() {
-    static_assert(sizeof(T) <= kScratchBytes, "fits the scratch RAM");
-    return *reinterpret_cast<T*>(g_scratch);
-}
-#pragma GCC diagnostic pop
+/// settings_changed(). While push_line() shapes a curve, curve_shape() keeps its track in bytes
+/// of the work block that are dead by then (scratch.h).
+// (In scratch.h, as the curve track's share of it.)
+using ll::g_scratch;
+using ll::kScratchBytes;
+using ll::scratch;
 
 /// Power-up state: position zero, nothing queued, step timer stopped. Call once before
 /// settings_changed().
