@@ -292,9 +292,10 @@ void Planner::finish_block(uint8_t group, uint8_t curve, uint32_t feed,
     memcpy(prev_unit_, unit_in, sizeof(prev_unit_)); // a curve then writes its end tangent
 }
 
-// The deepest stack of the firmware is curve_shape()'s: shape_curve() (inline: curve_shape()
-// runs straight under push_line()) keeps its result in the free slot, and add_curve() fills the
-// slot with the curve once the shape is used.
+// curve_shape() is one of the deepest stacks of the firmware (with stepping a curve: poll() ->
+// begin_curve()): shape_curve() (inline: curve_shape() runs straight under push_line()) keeps
+// its result in the free slot, and add_curve() fills the slot with the curve once the shape is
+// used.
 void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                         const CurveParams& curve) {
     const uint8_t plane = curve.plane;
