@@ -371,7 +371,6 @@ const FnList kPlannerFns = {
     {"_ZN2ll6motion4pollEv", "motion::poll (step generation)"},
     {"_ZNK2ll7Planner13spec_of_firstEv", "Planner::spec_of_first"},
     {"_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "StepGen::begin"},
-    {"_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE", "StepGen::fill"},
     {"_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE", "StepGen::fill"},
     {"_ZN2ll3hal10serial_putEh", "hal::serial_put"},
     {"_ZN2ll3app8run_onceEv", "app::run_once (the whole main loop)"},
@@ -479,8 +478,7 @@ CircleRun circle_run(const Config& cfg, double radius, bool send_and_wait, bool 
         std::vector<bool> is_gen(kPlannerFns.size(), false);
         for (const char* g :
              {"_ZN2ll6motion4pollEv", "_ZNK2ll7Planner13spec_of_firstEv",
-              "_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE",
-              "_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE"}) {
+              "_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE"}) {
             const int k = prof->index_of(g);
             if (k >= 0) is_gen[static_cast<size_t>(k)] = true;
         }
@@ -627,22 +625,18 @@ std::vector<FnCost> producer_profile(const Config& cfg, double rate, double mm, 
                                      double* motion_cycles) {
     const FnList fns = {
         {"_ZN2ll6motion4pollEv", "motion::poll"},
-        {"_ZN2ll7StepGen4fillERNS_7RunRingILh32EEE", "StepGen::fill"},
+        {"_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE", "StepGen::fill"},
         {"_ZN2ll12line_advanceERKNS_12LineGeometryERNS_10LineCursorEhPh", "line_advance"},
         {"_ZN2ll11micro_splitEPKhhPNS_8MicroRunE", "micro_split"},
         {"_ZN2ll9profile_aERKNS_7ProfileEm", "profile_a"},
         {"_ZN2ll11SqrtTracker4seekEm", "SqrtTracker::seek"},
-        {"_ZN2ll7StepGen4emitERNS_7RunRingILh32EEEhhm", "StepGen::emit"},
-        {"_ZN2ll7StepGen13queued_cyclesERKNS_7RunRingILh32EEE", "StepGen::queued_cycles"},
+        {"_ZN2ll7StepGen4emitERNS_7RunRingILh16EEEhhhm", "StepGen::emit"},
+        {"_ZN2ll7StepGen11horizon_fullERKNS_7RunRingILh16EEE", "StepGen::horizon_full"},
         {"_ZN2ll7mul_shrEmmh", "mul_shr"},
         {"__udivmodsi4", "__udivmodsi4 (32-bit division)"},
         {"__mulsi3", "__mulsi3"},
         {"_ZN2ll7StepGen8set_exitEm", "StepGen::set_exit"},
         {"_ZN2ll7StepGen5beginERKNS_8MoveSpecE", "StepGen::begin"},
-        // The same with a 16-run queue (config.h kRunQueueSize).
-        {"_ZN2ll7StepGen4fillERNS_7RunRingILh16EEE", "StepGen::fill"},
-        {"_ZN2ll7StepGen4emitERNS_7RunRingILh16EEEhhhm", "StepGen::emit"},
-        {"_ZN2ll7StepGen13queued_cyclesERKNS_7RunRingILh16EEE", "StepGen::queued_cycles"},
     };
     Board b(cfg.elf);
     b.settings({"$0=3", "$100=1000", "$110=300000", "$120=2000", "G91"});
