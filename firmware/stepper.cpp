@@ -254,12 +254,10 @@ void stepper_init() {
     TCCR1A = 0;
     TIMSK1 = _BV(OCIE1A) | _BV(OCIE1B); // the timer only runs while there are runs
     GPIOR0 = 0;
-    // What stepper_configure(StepperConfig{160, 0, 0, 0}) would do: 10 us pulses, nothing
-    // inverted. The masks and step pins are already 0 (static RAM, board_init()).
-    constexpr uint16_t kBootPulse = 160;
-    s_ocr1b = static_cast<uint16_t>(st::effective_pulse(kBootPulse) - 1 + st::kPulseGuard);
-    s_min_period = st::min_period(kBootPulse);
-    hal::stepper_enable(false);
+    // The pulse width, the guard period and the pin polarities come from stepper_configure(),
+    // which app::init() calls (motion::settings_changed()) before any run can start (llbench
+    // sends the bench app a `C` first). stepper_enable(false) here would repeat board_init()'s
+    // level (s_enable_invert is still 0).
 }
 
 } // namespace fw
