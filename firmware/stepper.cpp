@@ -267,13 +267,13 @@ namespace hal {
 void stepper_configure(const StepperConfig& cfg) {
     uint16_t pulse = st::effective_pulse(cfg.pulse_cycles);
     s_ocr1b = static_cast<uint16_t>(pulse - 1 + st::kPulseGuard);
-    s_min_period = st::min_period(cfg.pulse_cycles);
+    s_min_period = static_cast<uint16_t>(pulse + st::kPeriodMargin); // st::min_period()
     uint8_t idle_d = board::step_port_bits<Port::D>(cfg.step_invert);
     uint8_t idle_b = board::step_port_bits<Port::B>(cfg.step_invert);
     s_idle_d = idle_d;
     s_idle_b = idle_b;
     s_dir_invert = cfg.dir_invert;
-    s_enable_invert = cfg.enable_invert ? 1 : 0;
+    s_enable_invert = cfg.enable_invert;
     fw::IrqGuard g;
     PORTD = static_cast<uint8_t>((PORTD & ~board::kStepMaskD) | idle_d);
     PORTB = static_cast<uint8_t>((PORTB & ~board::kStepMaskB) | idle_b);
@@ -342,7 +342,8 @@ void stepper_stop() {
 
 void stepper_enable(bool on) {
     // One sbi/cbi: atomic against the step interrupt's PINB toggles.
-    if ((on ? 0 : 1) ^ s_enable_invert) {
+    // High when enabled with $4 = 1, or disabled with $4 = 0.
+    if (on == (s_enable_invert != 0)) {
         PORTB |= board::Enable::kMask;
     } else {
         PORTB &= static_cast<uint8_t>(~board::Enable::kMask);
