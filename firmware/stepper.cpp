@@ -280,8 +280,11 @@ void stepper_configure(const StepperConfig& cfg) {
 }
 
 void stepper_start() {
-    if (g_exec.running || g_runs.empty()) return;
-    const Run& r = g_runs.front();
+    if (g_exec.running) return;
+    // The timer is stopped: head only changes here, so it is read once (volatile).
+    uint8_t head = g_runs.head;
+    if (head == g_runs.tail) return;
+    const Run& r = g_runs.buf[head];
     uint8_t steps = r.steps;
     uint8_t dirs = r.dirs;
     uint8_t count = r.count; // read before the volatile guard: r is not looked up again
@@ -293,7 +296,7 @@ void stepper_start() {
     g_exec.dirs = dirs;
     g_exec.starved = 0;
     g_exec.running = 1;
-    g_runs.pop();
+    g_runs.head = static_cast<uint8_t>((head + 1) & (kRunQueueSize - 1)); // pop()
 
     GPIOR1 = board::step_port_bits<Port::D>(steps);
     s_step_b = board::step_port_bits<Port::B>(steps);
