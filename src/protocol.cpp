@@ -60,7 +60,7 @@ struct Protocol {
     char line[protocol::kLineMax + 1];
     uint8_t len;
     uint8_t flags;
-    uint8_t last_cr;    // the previous byte was '\r': a '\n' right after it ends nothing
+    uint8_t last;       // the previous byte: a '\n' right after a '\r' ends nothing
     uint8_t lost_after; // after this many more bytes, the line in progress lost bytes
     uint8_t gflags;     // gcode::execute() flags for the pending line
     Wait wait;
@@ -306,13 +306,13 @@ void read_line() {
         uint8_t got;
         if (!hal::serial_get(got)) return;
         uint8_t c = got;
+        uint8_t prev = p.last;
+        p.last = c;
         bool end = false;
         uint8_t f = p.flags;
         if (c == '\n' || c == '\r') {
-            end = !(c == '\n' && p.last_cr); // CR LF is one line end
-            p.last_cr = c == '\r';
+            end = !(c == '\n' && prev == '\r'); // CR LF is one line end
         } else {
-            p.last_cr = 0;
             if (c == '\t') c = ' ';
             if (c < 0x20 || c >= 0x7F) {
                 f |= kBadByte; // GRBL drops such bytes and runs the rest; we refuse the line
