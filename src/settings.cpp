@@ -6,6 +6,7 @@
 
 #include "lowlevel/hal.h"
 #include "lowlevel/print.h"
+#include "lowlevel/scratch.h"
 #include "lowlevel/status.h"
 
 namespace ll {
@@ -137,7 +138,11 @@ void restore_defaults() {
 }
 
 void clear_coord() {
-    int32_t zero[kAxes] = {};
+    // The zeros in the scratch RAM (scratch.h; motion.h says when it is free: `$RST` and app::init
+    // only), not in a 16-byte frame.
+    using Coords = int32_t[kAxes];
+    Coords& zero = scratch<Coords>();
+    memset(zero, 0, sizeof(zero));
     save_coord(zero);
 }
 
