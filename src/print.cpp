@@ -47,10 +47,6 @@ void scaled(int32_t v, uint8_t mul, uint16_t div, uint8_t decimals) {
 }
 } // namespace
 
-void ch(char c) {
-    hal::serial_put(static_cast<uint8_t>(c));
-}
-
 void str(const FlashChar* s) {
     for (;;) {
         char c = static_cast<char>(flash_read_byte(s));
