@@ -105,24 +105,27 @@ bool record(uint16_t addr, void* data, uint8_t n, bool write) {
            transfer(static_cast<uint16_t>(addr + 1), b, write) == b;
 }
 
-// GRBL 1.1h's generic machine, $10=3 and the speed groups X Y Z -> 0, A B C -> 1.
-constexpr Settings make_defaults() {
-    Settings s{};
+// GRBL 1.1h's generic machine, $10=3 and the speed groups X Y Z -> 0, A B C -> 1. Every axis has
+// the same defaults, so flash keeps the first one only (SettingsFor<1>: the same layout up to
+// it) and restore_defaults() repeats it (kAxes copies took 48 B more).
+constexpr SettingsFor<1> make_defaults() {
+    SettingsFor<1> s{};
     s.pulse_us = 10;
     s.idle_delay_ms = 25;
     s.status_mask = 3; // MPos and Bf: (GRBL 1.1h: 1, MPos only; see docs/protocol.md)
     s.junction_dev = 10;
     s.arc_tolerance = 2;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        s.axis_group[a] = a < 3 ? 0 : 1;
-        s.axis[a].steps_per_unit = 250000;
-        s.axis[a].max_rate = 500000;
-        s.axis[a].accel = 10000;
-        s.axis[a].max_travel = 200000;
-    }
+    for (uint8_t a = 0; a < kAxes; ++a) s.axis_group[a] = a < 3 ? 0 : 1;
+    s.axis[0].steps_per_unit = 250000;
+    s.axis[0].max_rate = 500000;
+    s.axis[0].accel = 10000;
+    s.axis[0].max_travel = 200000;
     return s;
 }
-const Settings kDefaults LL_PROGMEM = make_defaults();
+const SettingsFor<1> kDefaults LL_PROGMEM = make_defaults();
+static_assert(offsetof(SettingsFor<1>, axis) == offsetof(Settings, axis) &&
+                  sizeof(SettingsFor<1>) + (kAxes - 1) * sizeof(AxisSettings) == sizeof(Settings),
+              "the defaults are Settings up to the first axis");
 
 void save() {
     hal::eeprom_write(0, kEepromVersion);
@@ -132,7 +135,12 @@ void save() {
 } // namespace
 
 void restore_defaults() {
-    flash_copy(&g_settings, &kDefaults, sizeof(Settings));
+    flash_copy(&g_settings, &kDefaults, sizeof(kDefaults));
+    // The first axis repeated: a forward byte copy from one axis back.
+    uint8_t* axes = reinterpret_cast<uint8_t*>(g_settings.axis);
+    for (uint8_t i = 0; i < (kAxes - 1) * sizeof(AxisSettings); ++i) {
+        axes[i + sizeof(AxisSettings)] = axes[i];
+    }
     save();
     clear_coord();
 }
