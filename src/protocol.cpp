@@ -268,8 +268,7 @@ void run_gcode() {
 
 // A complete line: answer it, or start executing it.
 void dispatch() {
-    uint8_t f = p.flags;
-    p.line[p.len] = 0;
+    uint8_t f = p.flags; // p.line is terminated (read_line())
     if (f & (kLost | kBadByte | kTooLong)) {
         finish((f & kBadByte) && !(f & kLost) ? kUnsupportedCommand : kOverflow);
     } else if (p.len == 0) {
@@ -329,7 +328,10 @@ void read_line() {
                 f |= kTooLong;
             } else {
                 if (c >= 'a' && c <= 'z') c = static_cast<uint8_t>(c - ('a' - 'A'));
-                p.line[p.len++] = static_cast<char>(c);
+                // Kept terminated: the pointer is at hand here (dispatch() would compute it).
+                char* at = p.line + p.len++;
+                at[0] = static_cast<char>(c);
+                at[1] = 0;
             }
         }
         p.flags = f;
