@@ -61,7 +61,7 @@ struct Protocol {
     uint8_t len;
     uint8_t flags;
     uint8_t last;       // the previous byte: a '\n' right after a '\r' ends nothing
-    uint8_t lost_after; // after this many more bytes, the line in progress lost bytes
+    uint8_t lost_after; // the line of the lost_after-th byte from now lost bytes (0: none)
     uint8_t gflags;     // gcode::execute() flags for the pending line
     Wait wait;
     uint8_t check;         // `$C` check mode: 0 or 1 (= gcode::kCheckMode)
@@ -296,14 +296,15 @@ void read_line() {
     for (;;) {
         if (hal::serial_rx_overflowed()) {
             // Bytes were dropped after everything now in the buffer (nothing was read since the
-            // buffer filled up): the line in progress once those bytes are read lost some.
+            // buffer filled up): the line of the byte that follows those lost some. Marked as
+            // that byte is taken (the line in progress when the buffer is empty).
             uint8_t free = hal::serial_rx_free();
             if (free > p.rx_capacity) p.rx_capacity = free;
-            p.lost_after = static_cast<uint8_t>(p.rx_capacity - free);
-            if (p.lost_after == 0) p.flags |= kLost;
+            p.lost_after = static_cast<uint8_t>(p.rx_capacity - free + 1);
         }
         uint8_t got;
         if (!hal::serial_get(got)) return;
+        if (p.lost_after != 0 && --p.lost_after == 0) p.flags |= kLost;
         uint8_t c = got;
         uint8_t prev = p.last;
         p.last = c;
@@ -335,9 +336,10 @@ void read_line() {
             }
         }
         p.flags = f;
-        if (end) dispatch();
-        if (p.lost_after != 0 && --p.lost_after == 0) p.flags |= kLost;
-        if (end) return; // one line per run_once()
+        if (end) {
+            dispatch();
+            return; // one line per run_once()
+        }
     }
 }
 
