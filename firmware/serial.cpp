@@ -4,8 +4,9 @@
 // interrupts as soon as their source is cleared:
 //   - receive: a naked stub disables the receive interrupt (one constant store: nothing else
 //     ever changes UCSR0B) and re-enables interrupts, 8 cycles after the vector; the rest runs
-//     interruptible in rx_drain(), which empties the 2-byte hardware FIFO in arrival order and
-//     then re-enables the receive interrupt. Order can never be swapped by a nested receive.
+//     interruptible in rx_drain(), which takes the oldest byte of the 2-byte hardware FIFO and
+//     then re-enables the receive interrupt (which comes again at once for a second byte). Order
+//     can never be swapped by a nested receive.
 //   - transmit: the "transmit complete" interrupt (its flag clears itself when the vector
 //     runs), so the handler starts with sei (its first instruction). It refills UDR0 with up to two
 //     bytes (shift register + buffer). The "data register empty" interrupt would need UDRIE
@@ -61,13 +62,13 @@ bool rx_push(uint8_t byte) {
 extern "C" void __vector_rx_drain() __attribute__((signal, used, externally_visible));
 void __vector_rx_drain() {
     using namespace ll;
-    do {
-        uint8_t status = UCSR0A;
-        uint8_t byte = UDR0;
-        // DOR0: the hardware lost a byte before this one.
-        if (!rx_push(byte) || (status & _BV(DOR0))) s_rx_overflow = 1;
-    } while (UCSR0A & _BV(RXC0));
-    UCSR0B = kUcsr0bRun; // a byte that arrived meanwhile raises the interrupt again at once
+    uint8_t status = UCSR0A;
+    uint8_t byte = UDR0;
+    // DOR0: the hardware lost a byte before this one.
+    if (!rx_push(byte) || (status & _BV(DOR0))) s_rx_overflow = 1;
+    // A second byte in the FIFO (or one that arrived meanwhile) raises the interrupt again at
+    // once: one byte per entry (a loop here took 8 B more).
+    UCSR0B = kUcsr0bRun;
 }
 
 ISR(USART_RX_vect, ISR_NAKED) {
