@@ -279,13 +279,12 @@ void dispatch() {
         if (r == kOkThenReset) soft_reset();
     } else if (p.alarm) {
         finish(kGcodeLock);
-    } else if (!motion::can_accept()) {
-        // The planner is full: parse the line once it has room rather than now and again then
-        // (the parse is a third of a short line's cost, and a streaming sender keeps the
-        // planner full). A line that would not move waits for that room too.
-        p.wait = Wait::WhenAccepting;
     } else {
-        run_gcode();
+        // Parsed by advance_wait() once the planner has room (in the next run_once() when it has
+        // some now): when it is full, parsing now and again then would double the parse, a
+        // third of a short line's cost, and a streaming sender keeps the planner full. A line
+        // that would not move waits for that room too.
+        p.wait = Wait::WhenAccepting;
     }
     p.len = 0;
     p.flags = 0;
@@ -302,12 +301,10 @@ void read_line() {
             if (free > p.rx_capacity) p.rx_capacity = free;
             p.lost_after = static_cast<uint8_t>(p.rx_capacity - free + 1);
         }
-        uint8_t got;
-        if (!hal::serial_get(got)) return;
-        if (p.lost_after != 0 && --p.lost_after == 0) p.flags |= kLost;
-        uint8_t c = got;
         uint8_t prev = p.last;
-        p.last = c;
+        if (!hal::serial_get(p.last)) return; // straight into p.last: no frame for it
+        if (p.lost_after != 0 && --p.lost_after == 0) p.flags |= kLost;
+        uint8_t c = p.last;
         bool end = false;
         uint8_t f = p.flags;
         if (c == '\n' || c == '\r') {
