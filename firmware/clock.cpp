@@ -46,10 +46,9 @@ namespace ll {
 namespace fw {
 
 void clock_init() {
+    // TCNT2 and the flags keep their reset value 0 (main.cpp).
     TCCR2A = _BV(WGM21); // CTC
     OCR2A = 249;         // 250 ticks of 4 µs
-    TCNT2 = 0;
-    TIFR2 = _BV(OCF2A);
     TIMSK2 = _BV(OCIE2A);
     TCCR2B = _BV(CS22); // clk/64
 }

@@ -136,10 +136,9 @@ namespace ll {
 namespace fw {
 
 void serial_init() {
-    UBRR0H = 0;
+    // UBRR0H (0) and UCSR0C (8N1) keep their reset values (main.cpp).
     UBRR0L = kUbrr;
     UCSR0A = _BV(U2X0);
-    UCSR0C = _BV(UCSZ01) | _BV(UCSZ00); // 8N1
     UCSR0B = kUcsr0bRun;
 }
 
