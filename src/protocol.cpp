@@ -195,10 +195,11 @@ __attribute__((noinline)) uint8_t system_command() {
     }
     char c1 = s[1];
     bool one_letter = c1 == 0;
+    bool busy = !motion_idle(); // asked once for the three commands that need idle
     if (c == '$' || c == 'G' || c == 'C' || c == 'X') {
         if (!one_letter) return kInvalidStatement;
         if (c == '$') {
-            if (!motion_idle()) return kIdleError; // too long to print while moving
+            if (busy) return kIdleError; // too long to print while moving
             settings::report();
         } else if (c == 'G') {
             gcode::report_modes();
@@ -207,7 +208,7 @@ __attribute__((noinline)) uint8_t system_command() {
                 out::msg(LL_PSTR("Disabled"));
                 return kOkThenReset; // restores the parser state check mode changed
             }
-            if (p.alarm || !motion_idle()) return kIdleError;
+            if (p.alarm || busy) return kIdleError;
             p.check = 1;
             out::msg(LL_PSTR("Enabled"));
         } else if (p.alarm) {
@@ -217,7 +218,7 @@ __attribute__((noinline)) uint8_t system_command() {
         return kOk;
     }
     // The rest needs the machine idle (or in alarm), as in GRBL.
-    if (p.check || !motion_idle()) return kIdleError;
+    if (p.check || busy) return kIdleError;
     if (c == '#' || c == 'I') {
         if (!one_letter) return kInvalidStatement;
         if (c == '#') {
