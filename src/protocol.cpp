@@ -79,7 +79,9 @@ Protocol p;
 // it): ld/st instead of lds/sts for its four bytes (16 B less for the two uses).
 uint32_t& dwell_ms() {
     uint32_t* d = &p.o.dwell_ms;
-    asm("" : "+e"(d));
+#if defined(__AVR__)
+    asm("" : "+e"(d)); // X, Y or Z: the compiler no longer sees the constant address
+#endif
     return *d;
 }
 
