@@ -66,6 +66,7 @@ static_assert(_SFR_IO_ADDR(TIFR1) < 0x20, "sbis on TIFR1");
 volatile uint8_t s_step_b;      // see the file comment
 volatile uint8_t s_end_b;       // see the file comment
 volatile uint16_t s_min_period; // guard for OCR1A, cycles (step_timing::min_period)
+uint16_t s_ocr1b;               // pulse width - 1 + kPulseGuard
 uint8_t s_idle_d;               // step pin levels at rest ($2), port D
 uint8_t s_idle_b;               // step pin levels at rest ($2), port B
 uint8_t s_dir_invert;           // $3, axis bits
@@ -263,9 +264,7 @@ namespace hal {
 
 void stepper_configure(const StepperConfig& cfg) {
     uint16_t pulse = st::effective_pulse(cfg.pulse_cycles);
-    // Written once here (the timer is stopped, CTC: no double buffering): nothing else changes
-    // OCR1B. (Kept in RAM and loaded at each start, it took 16 B more and 2 B of RAM.)
-    OCR1B = static_cast<uint16_t>(pulse - 1 + st::kPulseGuard);
+    s_ocr1b = static_cast<uint16_t>(pulse - 1 + st::kPulseGuard);
     s_min_period = static_cast<uint16_t>(pulse + st::kPeriodMargin); // st::min_period()
     uint8_t idle_d = board::step_port_bits<Port::D>(cfg.step_invert);
     uint8_t idle_b = board::step_port_bits<Port::B>(cfg.step_invert);
@@ -305,6 +304,7 @@ void stepper_start() {
     s_end_b = 0;
     GPIOR0 = _BV(kBitArm);
     OCR1A = static_cast<uint16_t>(period - 1);
+    OCR1B = s_ocr1b;
     TCNT1 = 0;
     TIFR1 = _BV(OCF1A) | _BV(OCF1B);
 
