@@ -94,9 +94,11 @@ __attribute__((noinline)) uint8_t transfer(uint16_t addr, uint8_t v, bool write)
 bool record(uint16_t addr, void* data, uint8_t n, bool write) {
     uint8_t* p = static_cast<uint8_t*>(data);
     uint8_t a = 0x5A, b = 0xA5;
-    for (uint8_t i = 0; i < n; ++i, ++addr) {
-        uint8_t v = transfer(addr, p[i], write);
-        p[i] = v; // unchanged when writing
+    for (; n != 0; --n, ++addr, ++p) {
+        // addr counted on its own (the compiler would derive it from p: 8 B a byte more).
+        asm("" : "+r"(addr));
+        uint8_t v = transfer(addr, *p, write);
+        *p = v; // unchanged when writing
         a = static_cast<uint8_t>(a + v);
         b = static_cast<uint8_t>(b + a);
     }
