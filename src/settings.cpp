@@ -67,17 +67,27 @@ struct Found {
     uint8_t kind;
 };
 Found find(uint8_t n) {
-    for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
-        uint8_t first = flash_read_byte(&row->number);
+    const Row* row = kRows;
+    do {
+        // The row's three bytes in turn, the pointer left on the next row (on the chip: lpm Z+,
+        // 10 B less than three addressed reads).
+        uint8_t first, kind, offset;
+#if defined(__AVR__)
+        asm("lpm %0, Z+\n\tlpm %1, Z+\n\tlpm %2, Z+"
+            : "=r"(first), "=r"(kind), "=r"(offset), "+z"(row));
+#else
+        first = row->number;
+        kind = row->kind;
+        offset = row->offset;
+        ++row;
+#endif
         uint8_t a = static_cast<uint8_t>(n - first);
         uint8_t count = first >= kFirstAxisNumber ? kAxes : 1; // compared in 8 bits
         if (a >= count) continue;
-        const uint8_t kind = flash_read_byte(&row->kind);
         uint8_t stride = kind == kGroup ? 1 : sizeof(AxisSettings);
-        return {reinterpret_cast<uint8_t*>(&g_settings) + flash_read_byte(&row->offset) +
-                    static_cast<uint8_t>(a * stride),
+        return {reinterpret_cast<uint8_t*>(&g_settings) + offset + static_cast<uint8_t>(a * stride),
                 kind};
-    }
+    } while (row != kRows + kRowCount);
     return {nullptr, 0};
 }
 
