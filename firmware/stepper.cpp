@@ -344,7 +344,7 @@ void stepper_stop() {
 void stepper_enable(bool on) {
     // One sbi/cbi: atomic against the step interrupt's PINB toggles.
     // High when enabled with $4 = 1, or disabled with $4 = 0.
-    if (on == (s_enable_invert != 0)) {
+    if (static_cast<uint8_t>(on) == s_enable_invert) { // both 0 or 1 (hal.h, $4)
         PORTB |= board::Enable::kMask;
     } else {
         PORTB &= static_cast<uint8_t>(~board::Enable::kMask);
