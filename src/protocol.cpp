@@ -281,7 +281,7 @@ void run_gcode() {
 void dispatch() {
     uint8_t f = p.flags; // p.line is terminated (read_line())
     if (f & (kLost | kBadByte | kTooLong)) {
-        finish((f & kBadByte) && !(f & kLost) ? kUnsupportedCommand : kOverflow);
+        finish((f & (kBadByte | kLost)) == kBadByte ? kUnsupportedCommand : kOverflow);
     } else if (p.len == 0) {
         finish(kOk); // empty or comment-only line: ok, for the sender's counting
     } else if (p.line[0] == '$') {
