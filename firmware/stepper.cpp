@@ -289,11 +289,13 @@ void stepper_start() {
     uint16_t period = r.period;
     uint16_t min_period = s_min_period;
     if (period < min_period) period = min_period;
-    g_exec.remaining = count;
-    g_exec.steps = steps;
-    g_exec.dirs = dirs;
-    g_exec.starved = 0;
-    g_exec.running = 1;
+    StepExec* e = &g_exec;
+    asm("" : "+e"(e)); // std through a pointer register, not sts by address
+    e->remaining = count;
+    e->steps = steps;
+    e->dirs = dirs;
+    e->starved = 0;
+    e->running = 1;
     g_runs.head = static_cast<uint8_t>((head + 1) & (kRunQueueSize - 1)); // pop()
 
     GPIOR1 = board::step_port_bits<Port::D>(steps);
