@@ -123,7 +123,11 @@ __attribute__((noinline)) void report_status() {
     static_assert(uint8_t(motion::State::Idle) == 0 && uint8_t(motion::State::Cycle) == 1 &&
                       uint8_t(motion::State::Holding) == 2 && uint8_t(motion::State::Held) == 3,
                   "state names follow motion::State");
-    uint8_t name = p.alarm ? 5 : p.check ? 4 : p.wait == Wait::Paused ? 3 : uint8_t(ms);
+    // In rising priority, each overriding the one before (straight-line code, no branch tree).
+    uint8_t name = uint8_t(ms);
+    if (p.wait == Wait::Paused) name = 3;
+    if (p.check) name = 4;
+    if (p.alarm) name = 5;
     const char* s =
         reinterpret_cast<const char*>(LL_PSTR("<Idle\0<Run\0<Hold:1\0<Hold:0\0<Check\0<Alarm"));
     while (name != 0) {
