@@ -290,8 +290,10 @@ void dispatch() {
         finish(kOk); // empty or comment-only line: ok, for the sender's counting
     } else if (p.line[0] == '$') {
         uint8_t r = system_command();
-        finish(r == kOkThenReset ? uint8_t(kOk) : r);
-        if (r == kOkThenReset) soft_reset();
+        bool reset = r == kOkThenReset;
+        if (reset) r = kOk;
+        finish(r);
+        if (reset) soft_reset();
     } else if (p.alarm) {
         finish(kGcodeLock);
     } else {
