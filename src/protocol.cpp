@@ -315,8 +315,9 @@ void read_line() {
             // buffer filled up): the line of the byte that follows those lost some. Marked as
             // that byte is taken (the line in progress when the buffer is empty).
             uint8_t free = hal::serial_rx_free();
-            if (free > p.rx_capacity) p.rx_capacity = free;
-            p.lost_after = static_cast<uint8_t>(p.rx_capacity - free + 1);
+            uint8_t capacity = p.rx_capacity;
+            if (free > capacity) p.rx_capacity = capacity = free;
+            p.lost_after = static_cast<uint8_t>(capacity - free + 1);
         }
         uint8_t prev = p.last;
         if (!hal::serial_get(p.last)) return; // straight into p.last: no frame for it
