@@ -1,8 +1,10 @@
-// Settings storage: the 1 KiB EEPROM through avr-libc (update semantics: an unchanged byte is
-// not rewritten). A write waits for the previous one (3.3 ms) with interrupts on; avr-libc
-// disables them only for the 4-cycle EEMPE/EEPE sequence.
-#include <avr/eeprom.h>
+// Settings storage: the 1 KiB EEPROM through its registers (update semantics: an unchanged byte
+// is not rewritten). A write waits for the previous one (3.4 ms) with interrupts on; they are
+// off only for the EEMPE/EEPE pair, which must come within 4 cycles. (avr-libc's
+// eeprom_read_byte and eeprom_update_byte and the calls to them took 18 B more.)
+#include <avr/io.h>
 
+#include "fw.h"
 #include "lowlevel/hal.h"
 
 namespace ll {
@@ -10,12 +12,21 @@ namespace hal {
 
 static_assert(kEepromSize == E2END + 1, "hal::kEepromSize matches the part");
 
-uint8_t eeprom_read(uint16_t addr) {
-    return eeprom_read_byte(reinterpret_cast<const uint8_t*>(addr % kEepromSize));
+__attribute__((noinline)) uint8_t eeprom_read(uint16_t addr) {
+    while (EECR & _BV(EEPE)) {
+    }
+    EEAR = addr % kEepromSize;
+    EECR |= _BV(EERE);
+    return EEDR;
 }
 
 void eeprom_write(uint16_t addr, uint8_t value) {
-    eeprom_update_byte(reinterpret_cast<uint8_t*>(addr % kEepromSize), value);
+    // Leaves EEAR at addr and the previous write finished.
+    if (eeprom_read(addr) == value) return;
+    EEDR = value;
+    fw::IrqGuard g;
+    EECR = _BV(EEMPE); // erase and write in one operation (EEPM = 0)
+    EECR |= _BV(EEPE);
 }
 
 } // namespace hal

@@ -1,4 +1,7 @@
-// Firmware entry point: hardware first (interrupts off), then the portable main loop.
+// Firmware entry point: hardware first (interrupts off), then the portable main loop. main() runs
+// right after a reset (Optiboot starts the application after a watchdog reset, or at once after
+// any reset but an external one), so the drivers write only registers whose reset value they do
+// not want.
 #include <avr/interrupt.h>
 
 #include "fw.h"

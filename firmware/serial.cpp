@@ -4,10 +4,11 @@
 // interrupts as soon as their source is cleared:
 //   - receive: a naked stub disables the receive interrupt (one constant store: nothing else
 //     ever changes UCSR0B) and re-enables interrupts, 8 cycles after the vector; the rest runs
-//     interruptible in rx_drain(), which empties the 2-byte hardware FIFO in arrival order and
-//     then re-enables the receive interrupt. Order can never be swapped by a nested receive.
+//     interruptible in rx_drain(), which takes the oldest byte of the 2-byte hardware FIFO and
+//     then re-enables the receive interrupt (which comes again at once for a second byte). Order
+//     can never be swapped by a nested receive.
 //   - transmit: the "transmit complete" interrupt (its flag clears itself when the vector
-//     runs), so the handler starts with sei (ISR_NOBLOCK). It refills UDR0 with up to two
+//     runs), so the handler starts with sei (its first instruction). It refills UDR0 with up to two
 //     bytes (shift register + buffer). The "data register empty" interrupt would need UDRIE
 //     toggled, i.e. a read-modify-write of UCSR0B shared with the receive stub.
 #include <avr/interrupt.h>
@@ -61,13 +62,13 @@ bool rx_push(uint8_t byte) {
 extern "C" void __vector_rx_drain() __attribute__((signal, used, externally_visible));
 void __vector_rx_drain() {
     using namespace ll;
-    do {
-        uint8_t status = UCSR0A;
-        uint8_t byte = UDR0;
-        // DOR0: the hardware lost a byte before this one.
-        if (!rx_push(byte) || (status & _BV(DOR0))) s_rx_overflow = 1;
-    } while (UCSR0A & _BV(RXC0));
-    UCSR0B = kUcsr0bRun; // a byte that arrived meanwhile raises the interrupt again at once
+    uint8_t status = UCSR0A;
+    uint8_t byte = UDR0;
+    // DOR0: the hardware lost a byte before this one.
+    if (!rx_push(byte) || (status & _BV(DOR0))) s_rx_overflow = 1;
+    // A second byte in the FIFO (or one that arrived meanwhile) raises the interrupt again at
+    // once: one byte per entry (a loop here took 8 B more).
+    UCSR0B = kUcsr0bRun;
 }
 
 ISR(USART_RX_vect, ISR_NAKED) {
@@ -81,31 +82,63 @@ ISR(USART_RX_vect, ISR_NAKED) {
                  : [masked] "M"(ll::kUcsr0bRxMasked), [ucsr0b] "n"(_SFR_MEM_ADDR(UCSR0B)));
 }
 
-ISR(USART_TX_vect, ISR_NOBLOCK) {
-    using namespace ll;
-    uint8_t h = s_tx_head;
-    uint8_t t = s_tx_tail;
-    if (h == t) {
-        s_tx_active = 0;
-        return;
-    }
-    // The shift register is empty: the first byte goes straight into it, the second waits in
-    // UDR0, so the line stays busy for two frames per interrupt.
-    do {
-        UDR0 = s_tx_buf[h & (kTxSize - 1)];
-        h = static_cast<uint8_t>(h + 1);
-    } while (h != t && (UCSR0A & _BV(UDRE0)));
-    s_tx_head = h;
+// The shift register is empty: the first byte goes straight into it, the second waits in UDR0,
+// so the line stays busy for two frames per interrupt. In assembly: C's version saved r0, r1
+// and SREG through r0, for 10 B more.
+ISR(USART_TX_vect, ISR_NAKED) {
+    asm volatile(
+        "sei\n\t"
+        "push r24\n\t"
+        "in   r24, __SREG__\n\t"
+        "push r24\n\t"
+        "push r25\n\t"
+        "push r30\n\t"
+        "push r31\n\t"
+        "lds  r24, %[head]\n\t"
+        "lds  r25, %[tail]\n\t"
+        "cp   r24, r25\n\t"
+        "brne 2f\n\t"
+        "clr  r30\n\t"
+        "sts  %[active], r30\n\t" // nothing left: no completion to come
+        "rjmp 4f\n\t"
+        "1:\n\t"
+        "lds  r30, %[ucsr0a]\n\t"
+        "sbrs r30, %[udre0]\n\t"
+        "rjmp 3f\n\t"
+        "2:\n\t"
+        "mov  r30, r24\n\t"
+        "andi r30, %[mask]\n\t"
+        "ldi  r31, 0\n\t"
+        "subi r30, lo8(-(%[buf]))\n\t"
+        "sbci r31, hi8(-(%[buf]))\n\t"
+        "ld   r30, Z\n\t"
+        "sts  %[udr0], r30\n\t"
+        "inc  r24\n\t"
+        "cpse r24, r25\n\t"
+        "rjmp 1b\n\t"
+        "3:\n\t"
+        "sts  %[head], r24\n\t"
+        "4:\n\t"
+        "pop  r31\n\t"
+        "pop  r30\n\t"
+        "pop  r25\n\t"
+        "pop  r24\n\t"
+        "out  __SREG__, r24\n\t"
+        "pop  r24\n\t"
+        "reti\n\t"
+        :
+        : [head] "i"(&ll::s_tx_head), [tail] "i"(&ll::s_tx_tail), [active] "i"(&ll::s_tx_active),
+          [buf] "i"(&ll::s_tx_buf[0]), [mask] "M"(ll::kTxSize - 1),
+          [ucsr0a] "n"(_SFR_MEM_ADDR(UCSR0A)), [udr0] "n"(_SFR_MEM_ADDR(UDR0)), [udre0] "I"(UDRE0));
 }
 
 namespace ll {
 namespace fw {
 
 void serial_init() {
-    UBRR0H = 0;
+    // UBRR0H (0) and UCSR0C (8N1) keep their reset values (main.cpp).
     UBRR0L = kUbrr;
     UCSR0A = _BV(U2X0);
-    UCSR0C = _BV(UCSZ01) | _BV(UCSZ00); // 8N1
     UCSR0B = kUcsr0bRun;
 }
 

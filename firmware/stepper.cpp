@@ -250,16 +250,12 @@ namespace ll {
 namespace fw {
 
 void stepper_init() {
-    TCCR1B = kTccr1bStopped;
-    TCCR1A = 0;
+    // TCCR1A, TCCR1B (no clock: stopped) and GPIOR0 keep their reset value 0 (main.cpp).
     TIMSK1 = _BV(OCIE1A) | _BV(OCIE1B); // the timer only runs while there are runs
-    GPIOR0 = 0;
-    // What stepper_configure(StepperConfig{160, 0, 0, 0}) would do: 10 us pulses, nothing
-    // inverted. The masks and step pins are already 0 (static RAM, board_init()).
-    constexpr uint16_t kBootPulse = 160;
-    s_ocr1b = static_cast<uint16_t>(st::effective_pulse(kBootPulse) - 1 + st::kPulseGuard);
-    s_min_period = st::min_period(kBootPulse);
-    hal::stepper_enable(false);
+    // The pulse width, the guard period and the pin polarities come from stepper_configure(),
+    // which app::init() calls (motion::settings_changed()) before any run can start (llbench
+    // sends the bench app a `C` first). stepper_enable(false) here would repeat board_init()'s
+    // level (s_enable_invert is still 0).
 }
 
 } // namespace fw
@@ -269,33 +265,38 @@ namespace hal {
 void stepper_configure(const StepperConfig& cfg) {
     uint16_t pulse = st::effective_pulse(cfg.pulse_cycles);
     s_ocr1b = static_cast<uint16_t>(pulse - 1 + st::kPulseGuard);
-    s_min_period = st::min_period(cfg.pulse_cycles);
+    s_min_period = static_cast<uint16_t>(pulse + st::kPeriodMargin); // st::min_period()
     uint8_t idle_d = board::step_port_bits<Port::D>(cfg.step_invert);
     uint8_t idle_b = board::step_port_bits<Port::B>(cfg.step_invert);
     s_idle_d = idle_d;
     s_idle_b = idle_b;
     s_dir_invert = cfg.dir_invert;
-    s_enable_invert = cfg.enable_invert ? 1 : 0;
+    s_enable_invert = cfg.enable_invert;
     fw::IrqGuard g;
     PORTD = static_cast<uint8_t>((PORTD & ~board::kStepMaskD) | idle_d);
     PORTB = static_cast<uint8_t>((PORTB & ~board::kStepMaskB) | idle_b);
 }
 
 void stepper_start() {
-    if (g_exec.running || g_runs.empty()) return;
-    const Run& r = g_runs.front();
+    if (g_exec.running) return;
+    // The timer is stopped: head only changes here, so it is read once (volatile).
+    uint8_t head = g_runs.head;
+    if (head == g_runs.tail) return;
+    const Run& r = g_runs.buf[head];
     uint8_t steps = r.steps;
     uint8_t dirs = r.dirs;
     uint8_t count = r.count; // read before the volatile guard: r is not looked up again
     uint16_t period = r.period;
     uint16_t min_period = s_min_period;
     if (period < min_period) period = min_period;
-    g_exec.remaining = count;
-    g_exec.steps = steps;
-    g_exec.dirs = dirs;
-    g_exec.starved = 0;
-    g_exec.running = 1;
-    g_runs.pop();
+    StepExec* e = &g_exec;
+    asm("" : "+e"(e)); // std through a pointer register, not sts by address
+    e->remaining = count;
+    e->steps = steps;
+    e->dirs = dirs;
+    e->starved = 0;
+    e->running = 1;
+    g_runs.head = static_cast<uint8_t>((head + 1) & (kRunQueueSize - 1)); // pop()
 
     GPIOR1 = board::step_port_bits<Port::D>(steps);
     s_step_b = board::step_port_bits<Port::B>(steps);
@@ -344,7 +345,8 @@ void stepper_stop() {
 
 void stepper_enable(bool on) {
     // One sbi/cbi: atomic against the step interrupt's PINB toggles.
-    if ((on ? 0 : 1) ^ s_enable_invert) {
+    // High when enabled with $4 = 1, or disabled with $4 = 0.
+    if (static_cast<uint8_t>(on) == s_enable_invert) { // both 0 or 1 (hal.h, $4)
         PORTB |= board::Enable::kMask;
     } else {
         PORTB &= static_cast<uint8_t>(~board::Enable::kMask);

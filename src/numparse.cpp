@@ -19,8 +19,9 @@ bool finish(bool negative, uint32_t magnitude, int32_t& out) {
 } // namespace
 
 const char* parse(const char* p, Decimal& out) {
-    uint8_t flags = 0;
-    if (*p == '-') flags = Decimal::kNegative;
+    // The sign counts once a digit is not zero ("-0" is not negative).
+    uint8_t flags = 0, negative = 0;
+    if (*p == '-') negative = Decimal::kNegative;
     if (*p == '-' || *p == '+') ++p;
     uint32_t ipart = 0;
     uint16_t frac = 0;
@@ -36,6 +37,7 @@ const char* parse(const char* p, Decimal& out) {
             continue;
         }
         any_digit = true;
+        if (d != 0) flags |= negative;
         if (place == 0xFF) {
             if (ipart > kMaxIpart / 10) return nullptr; // a 10th significant digit
             ipart = (ipart << 3) + (ipart << 1) + d;    // x10 without a call
@@ -58,8 +60,6 @@ const char* parse(const char* p, Decimal& out) {
         ++place;
     }
     if (!any_digit) return nullptr;
-    // "-0" is not negative.
-    if (ipart == 0 && frac == 0 && sub == 0 && !(flags & Decimal::kInexact)) flags = 0;
     out.ipart = ipart;
     out.frac = frac;
     out.sub = sub;

@@ -47,10 +47,6 @@ void scaled(int32_t v, uint8_t mul, uint16_t div, uint8_t decimals) {
 }
 } // namespace
 
-void ch(char c) {
-    hal::serial_put(static_cast<uint8_t>(c));
-}
-
 void str(const FlashChar* s) {
     for (;;) {
         char c = static_cast<char>(flash_read_byte(s));
@@ -74,14 +70,14 @@ void u32(uint32_t v) {
     digits(v, 0);
 }
 
-void u8(uint8_t v) {
+__attribute__((noinline)) void u8(uint8_t v) {
     digits(v, 0);
 }
 
 void word(char letter, uint8_t v) {
     ch(' ');
     ch(letter);
-    digits(v, 0);
+    u8(v); // not inlined: its widening is in one place
 }
 
 void fixed(int32_t v, uint8_t decimals) {

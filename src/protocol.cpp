@@ -60,8 +60,8 @@ struct Protocol {
     char line[protocol::kLineMax + 1];
     uint8_t len;
     uint8_t flags;
-    uint8_t last_cr;    // the previous byte was '\r': a '\n' right after it ends nothing
-    uint8_t lost_after; // after this many more bytes, the line in progress lost bytes
+    uint8_t last;       // the previous byte: a '\n' right after a '\r' ends nothing
+    uint8_t lost_after; // the line of the lost_after-th byte from now lost bytes (0: none)
     uint8_t gflags;     // gcode::execute() flags for the pending line
     Wait wait;
     uint8_t check;         // `$C` check mode: 0 or 1 (= gcode::kCheckMode)
@@ -74,6 +74,16 @@ struct Protocol {
     uint8_t rx_capacity; // receive buffer size, for `$I`
 };
 Protocol p;
+
+// &p.o.dwell_ms through a pointer register (taken after the hal::millis() call that clobbers
+// it): ld/st instead of lds/sts for its four bytes (16 B less for the two uses).
+uint32_t& dwell_ms() {
+    uint32_t* d = &p.o.dwell_ms;
+#if defined(__AVR__)
+    asm("" : "+e"(d)); // X, Y or Z: the compiler no longer sees the constant address
+#endif
+    return *d;
+}
 
 bool motion_idle() {
     return motion::state() == motion::State::Idle;
@@ -113,7 +123,11 @@ __attribute__((noinline)) void report_status() {
     static_assert(uint8_t(motion::State::Idle) == 0 && uint8_t(motion::State::Cycle) == 1 &&
                       uint8_t(motion::State::Holding) == 2 && uint8_t(motion::State::Held) == 3,
                   "state names follow motion::State");
-    uint8_t name = p.alarm ? 5 : p.check ? 4 : p.wait == Wait::Paused ? 3 : uint8_t(ms);
+    // In rising priority, each overriding the one before (straight-line code, no branch tree).
+    uint8_t name = uint8_t(ms);
+    if (p.wait == Wait::Paused) name = 3;
+    if (p.check) name = 4;
+    if (p.alarm) name = 5;
     const char* s =
         reinterpret_cast<const char*>(LL_PSTR("<Idle\0<Run\0<Hold:1\0<Hold:0\0<Check\0<Alarm"));
     while (name != 0) {
@@ -195,10 +209,11 @@ __attribute__((noinline)) uint8_t system_command() {
     }
     char c1 = s[1];
     bool one_letter = c1 == 0;
+    bool busy = !motion_idle(); // asked once for the three commands that need idle
     if (c == '$' || c == 'G' || c == 'C' || c == 'X') {
         if (!one_letter) return kInvalidStatement;
         if (c == '$') {
-            if (!motion_idle()) return kIdleError; // too long to print while moving
+            if (busy) return kIdleError; // too long to print while moving
             settings::report();
         } else if (c == 'G') {
             gcode::report_modes();
@@ -207,7 +222,7 @@ __attribute__((noinline)) uint8_t system_command() {
                 out::msg(LL_PSTR("Disabled"));
                 return kOkThenReset; // restores the parser state check mode changed
             }
-            if (p.alarm || !motion_idle()) return kIdleError;
+            if (p.alarm || busy) return kIdleError;
             p.check = 1;
             out::msg(LL_PSTR("Enabled"));
         } else if (p.alarm) {
@@ -217,7 +232,7 @@ __attribute__((noinline)) uint8_t system_command() {
         return kOk;
     }
     // The rest needs the machine idle (or in alarm), as in GRBL.
-    if (p.check || !motion_idle()) return kIdleError;
+    if (p.check || busy) return kIdleError;
     if (c == '#' || c == 'I') {
         if (!one_letter) return kInvalidStatement;
         if (c == '#') {
@@ -268,25 +283,25 @@ void run_gcode() {
 
 // A complete line: answer it, or start executing it.
 void dispatch() {
-    uint8_t f = p.flags;
-    p.line[p.len] = 0;
+    uint8_t f = p.flags; // p.line is terminated (read_line())
     if (f & (kLost | kBadByte | kTooLong)) {
-        finish((f & kBadByte) && !(f & kLost) ? kUnsupportedCommand : kOverflow);
+        finish((f & (kBadByte | kLost)) == kBadByte ? kUnsupportedCommand : kOverflow);
     } else if (p.len == 0) {
         finish(kOk); // empty or comment-only line: ok, for the sender's counting
     } else if (p.line[0] == '$') {
         uint8_t r = system_command();
-        finish(r == kOkThenReset ? uint8_t(kOk) : r);
-        if (r == kOkThenReset) soft_reset();
+        bool reset = r == kOkThenReset;
+        if (reset) r = kOk;
+        finish(r);
+        if (reset) soft_reset();
     } else if (p.alarm) {
         finish(kGcodeLock);
-    } else if (!motion::can_accept()) {
-        // The planner is full: parse the line once it has room rather than now and again then
-        // (the parse is a third of a short line's cost, and a streaming sender keeps the
-        // planner full). A line that would not move waits for that room too.
-        p.wait = Wait::WhenAccepting;
     } else {
-        run_gcode();
+        // Parsed by advance_wait() once the planner has room (in the next run_once() when it has
+        // some now): when it is full, parsing now and again then would double the parse, a
+        // third of a short line's cost, and a streaming sender keeps the planner full. A line
+        // that would not move waits for that room too.
+        p.wait = Wait::WhenAccepting;
     }
     p.len = 0;
     p.flags = 0;
@@ -297,45 +312,45 @@ void read_line() {
     for (;;) {
         if (hal::serial_rx_overflowed()) {
             // Bytes were dropped after everything now in the buffer (nothing was read since the
-            // buffer filled up): the line in progress once those bytes are read lost some.
+            // buffer filled up): the line of the byte that follows those lost some. Marked as
+            // that byte is taken (the line in progress when the buffer is empty).
             uint8_t free = hal::serial_rx_free();
-            if (free > p.rx_capacity) p.rx_capacity = free;
-            p.lost_after = static_cast<uint8_t>(p.rx_capacity - free);
-            if (p.lost_after == 0) p.flags |= kLost;
+            uint8_t capacity = p.rx_capacity;
+            if (free > capacity) p.rx_capacity = capacity = free;
+            p.lost_after = static_cast<uint8_t>(capacity - free + 1);
         }
-        uint8_t got;
-        if (!hal::serial_get(got)) return;
-        uint8_t c = got;
-        bool end = false;
-        uint8_t f = p.flags;
+        uint8_t prev = p.last;
+        if (!hal::serial_get(p.last)) return; // straight into p.last: no frame for it
+        if (p.lost_after != 0 && --p.lost_after == 0) p.flags |= kLost;
+        uint8_t c = p.last;
         if (c == '\n' || c == '\r') {
-            end = !(c == '\n' && p.last_cr); // CR LF is one line end
-            p.last_cr = c == '\r';
+            if (c == '\n' && prev == '\r') continue; // CR LF is one line end
+            dispatch();
+            return; // one line per run_once()
+        }
+        uint8_t f = p.flags;
+        if (c == '\t') c = ' ';
+        if (c < 0x20 || c >= 0x7F) {
+            f |= kBadByte; // GRBL drops such bytes and runs the rest; we refuse the line
+        } else if (f & kInSemicolon) {
+        } else if (f & kInParen) {
+            if (c == ')') f &= static_cast<uint8_t>(~kInParen);
+        } else if (c == ' ' || c == '/') {
+            // spaces and tabs, and block delete (ignored, as GRBL does)
+        } else if (c == '(') {
+            f |= kInParen;
+        } else if (c == ';') {
+            f |= kInSemicolon;
+        } else if (p.len >= protocol::kLineMax) {
+            f |= kTooLong;
         } else {
-            p.last_cr = 0;
-            if (c == '\t') c = ' ';
-            if (c < 0x20 || c >= 0x7F) {
-                f |= kBadByte; // GRBL drops such bytes and runs the rest; we refuse the line
-            } else if (f & kInSemicolon) {
-            } else if (f & kInParen) {
-                if (c == ')') f &= static_cast<uint8_t>(~kInParen);
-            } else if (c == ' ' || c == '/') {
-                // spaces and tabs, and block delete (ignored, as GRBL does)
-            } else if (c == '(') {
-                f |= kInParen;
-            } else if (c == ';') {
-                f |= kInSemicolon;
-            } else if (p.len >= protocol::kLineMax) {
-                f |= kTooLong;
-            } else {
-                if (c >= 'a' && c <= 'z') c = static_cast<uint8_t>(c - ('a' - 'A'));
-                p.line[p.len++] = static_cast<char>(c);
-            }
+            if (c >= 'a' && c <= 'z') c = static_cast<uint8_t>(c - ('a' - 'A'));
+            // Kept terminated: the pointer is at hand here (dispatch() would compute it).
+            char* at = p.line + p.len++;
+            at[0] = static_cast<char>(c);
+            at[1] = 0;
         }
         p.flags = f;
-        if (end) dispatch();
-        if (p.lost_after != 0 && --p.lost_after == 0) p.flags |= kLost;
-        if (end) return; // one line per run_once()
     }
 }
 
@@ -346,7 +361,8 @@ void advance_wait() {
         return;
     }
     if (w == Wait::Dwell) {
-        if (static_cast<int32_t>(hal::millis() - p.o.dwell_ms) >= 0) {
+        uint32_t now = hal::millis();
+        if (static_cast<int32_t>(now - dwell_ms()) >= 0) {
             p.gflags = gcode::kDwellDone;
             run_gcode();
         }
@@ -357,7 +373,8 @@ void advance_wait() {
     if (w == Wait::WhenIdle) {
         run_gcode();
     } else if (w == Wait::DwellWhenIdle) {
-        p.o.dwell_ms += hal::millis();
+        uint32_t now = hal::millis();
+        dwell_ms() += now;
         p.wait = Wait::Dwell;
     } else if (w == Wait::PauseWhenIdle) {
         p.wait = Wait::Paused;

@@ -6,6 +6,7 @@
 
 #include "lowlevel/hal.h"
 #include "lowlevel/print.h"
+#include "lowlevel/scratch.h"
 #include "lowlevel/status.h"
 
 namespace ll {
@@ -66,17 +67,27 @@ struct Found {
     uint8_t kind;
 };
 Found find(uint8_t n) {
-    for (const Row* row = kRows; row != kRows + kRowCount; ++row) {
-        uint8_t first = flash_read_byte(&row->number);
+    const Row* row = kRows;
+    do {
+        // The row's three bytes in turn, the pointer left on the next row (on the chip: lpm Z+,
+        // 10 B less than three addressed reads).
+        uint8_t first, kind, offset;
+#if defined(__AVR__)
+        asm("lpm %0, Z+\n\tlpm %1, Z+\n\tlpm %2, Z+"
+            : "=r"(first), "=r"(kind), "=r"(offset), "+z"(row));
+#else
+        first = row->number;
+        kind = row->kind;
+        offset = row->offset;
+        ++row;
+#endif
         uint8_t a = static_cast<uint8_t>(n - first);
         uint8_t count = first >= kFirstAxisNumber ? kAxes : 1; // compared in 8 bits
         if (a >= count) continue;
-        const uint8_t kind = flash_read_byte(&row->kind);
         uint8_t stride = kind == kGroup ? 1 : sizeof(AxisSettings);
-        return {reinterpret_cast<uint8_t*>(&g_settings) + flash_read_byte(&row->offset) +
-                    static_cast<uint8_t>(a * stride),
+        return {reinterpret_cast<uint8_t*>(&g_settings) + offset + static_cast<uint8_t>(a * stride),
                 kind};
-    }
+    } while (row != kRows + kRowCount);
     return {nullptr, 0};
 }
 
@@ -93,9 +104,11 @@ __attribute__((noinline)) uint8_t transfer(uint16_t addr, uint8_t v, bool write)
 bool record(uint16_t addr, void* data, uint8_t n, bool write) {
     uint8_t* p = static_cast<uint8_t*>(data);
     uint8_t a = 0x5A, b = 0xA5;
-    for (uint8_t i = 0; i < n; ++i, ++addr) {
-        uint8_t v = transfer(addr, p[i], write);
-        p[i] = v; // unchanged when writing
+    for (; n != 0; --n, ++addr, ++p) {
+        // addr counted on its own (the compiler would derive it from p: 8 B a byte more).
+        asm("" : "+r"(addr));
+        uint8_t v = transfer(addr, *p, write);
+        *p = v; // unchanged when writing
         a = static_cast<uint8_t>(a + v);
         b = static_cast<uint8_t>(b + a);
     }
@@ -104,24 +117,27 @@ bool record(uint16_t addr, void* data, uint8_t n, bool write) {
            transfer(static_cast<uint16_t>(addr + 1), b, write) == b;
 }
 
-// GRBL 1.1h's generic machine, $10=3 and the speed groups X Y Z -> 0, A B C -> 1.
-constexpr Settings make_defaults() {
-    Settings s{};
+// GRBL 1.1h's generic machine, $10=3 and the speed groups X Y Z -> 0, A B C -> 1. Every axis has
+// the same defaults, so flash keeps the first one only (SettingsFor<1>: the same layout up to
+// it) and restore_defaults() repeats it (kAxes copies took 48 B more).
+constexpr SettingsFor<1> make_defaults() {
+    SettingsFor<1> s{};
     s.pulse_us = 10;
     s.idle_delay_ms = 25;
     s.status_mask = 3; // MPos and Bf: (GRBL 1.1h: 1, MPos only; see docs/protocol.md)
     s.junction_dev = 10;
     s.arc_tolerance = 2;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        s.axis_group[a] = a < 3 ? 0 : 1;
-        s.axis[a].steps_per_unit = 250000;
-        s.axis[a].max_rate = 500000;
-        s.axis[a].accel = 10000;
-        s.axis[a].max_travel = 200000;
-    }
+    for (uint8_t a = 0; a < kAxes; ++a) s.axis_group[a] = a < 3 ? 0 : 1;
+    s.axis[0].steps_per_unit = 250000;
+    s.axis[0].max_rate = 500000;
+    s.axis[0].accel = 10000;
+    s.axis[0].max_travel = 200000;
     return s;
 }
-const Settings kDefaults LL_PROGMEM = make_defaults();
+const SettingsFor<1> kDefaults LL_PROGMEM = make_defaults();
+static_assert(offsetof(SettingsFor<1>, axis) == offsetof(Settings, axis) &&
+                  sizeof(SettingsFor<1>) + (kAxes - 1) * sizeof(AxisSettings) == sizeof(Settings),
+              "the defaults are Settings up to the first axis");
 
 void save() {
     hal::eeprom_write(0, kEepromVersion);
@@ -131,13 +147,22 @@ void save() {
 } // namespace
 
 void restore_defaults() {
-    flash_copy(&g_settings, &kDefaults, sizeof(Settings));
+    flash_copy(&g_settings, &kDefaults, sizeof(kDefaults));
+    // The first axis repeated: a forward byte copy from one axis back.
+    uint8_t* axes = reinterpret_cast<uint8_t*>(g_settings.axis);
+    for (uint8_t i = 0; i < (kAxes - 1) * sizeof(AxisSettings); ++i) {
+        axes[i + sizeof(AxisSettings)] = axes[i];
+    }
     save();
     clear_coord();
 }
 
 void clear_coord() {
-    int32_t zero[kAxes] = {};
+    // The zeros in the scratch RAM (scratch.h; motion.h says when it is free: `$RST` and app::init
+    // only), not in a 16-byte frame.
+    using Coords = int32_t[kAxes];
+    Coords& zero = scratch<Coords>();
+    memset(zero, 0, sizeof(zero));
     save_coord(zero);
 }
 

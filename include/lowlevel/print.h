@@ -6,12 +6,16 @@
 #include <stdint.h>
 
 #include "lowlevel/config.h"
+#include "lowlevel/hal.h"
 #include "lowlevel/pgm.h"
 
 namespace ll {
 namespace out {
 
-void ch(char c);
+/// One character (inline: the call goes straight to the driver).
+inline void ch(char c) {
+    hal::serial_put(static_cast<uint8_t>(c));
+}
 /// A string kept in flash (LL_PSTR).
 void str(const FlashChar* s);
 /// "\r\n", GRBL's line end.

@@ -15,7 +15,10 @@ struct AxisSettings {
     uint32_t max_travel;     ///< $130+a: mm (deg), x1000, >= 0
 };
 
-struct Settings {
+/// The settings with `AxisRecords` records of AxisSettings: Settings has kAxes of them (the
+/// flash copy of the defaults only one, settings.cpp).
+template <uint8_t AxisRecords>
+struct SettingsFor {
     uint8_t pulse_us;          ///< $0: step pulse width, microseconds
     uint8_t idle_delay_ms;     ///< $1: stepper idle lock time, ms (255 = keep enabled)
     uint8_t step_invert;       ///< $2: step port invert, axis mask
@@ -28,8 +31,9 @@ struct Settings {
     uint32_t arc_tolerance;    ///< $12: arc tolerance, mm x1000 (end-point check of arcs)
     uint8_t report_inches;     ///< $13: report in inches, boolean
     uint8_t axis_group[kAxes]; ///< $140+a: speed group of each axis (seed §3.1; issue 6)
-    AxisSettings axis[kAxes];
+    AxisSettings axis[AxisRecords];
 };
+using Settings = SettingsFor<kAxes>;
 
 extern Settings g_settings;
 
