@@ -629,25 +629,20 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
 
 uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     State& st = g_state;
-    outcome.then = Then::Nothing;
-    outcome.move = nullptr;
-    outcome.dwell_ms = 0;
+    static_assert(uint8_t(Then::Nothing) == 0, "an Outcome of zeros: nothing to do");
+    memset(&outcome, 0, sizeof(outcome));
 
     // ---- Stage 1: a block that starts from the current modes.
     Block& b = opaque(work().b);
     static_assert(offsetof(State, tool) == sizeof(Modal) && sizeof(Modal) + 1 == 8,
                   "modal and tool are two words");
-    b.g[kGroupNonModal] = kNoNonModal;
+    static_assert(kNoNonModal == 0 && kFlowRunning == 0 && kAxisNone == 0, "a header of zeros");
+    memset(&b, 0, offsetof(Block, v));            // and N
     copy_words(&b.g[kGroupMotion], &st.modal, 2); // and the tool into the flow byte:
+    b.tool = b.g[kGroupFlow];
     b.g[kGroupFlow] = kFlowRunning;
-    b.axis_command = kAxisNone;
-    b.overflow = 0;
     b.l = 0xFF;
-    b.tool = st.tool;
-    b.groups = 0;
-    b.words = 0;
     copy_words(&b.feed, &st.feed, 2); // and S
-    b.n = 0;
 
     // ---- Stage 2: import every word (letter + number), checking repeats, modal groups and
     // negative F N P S T.
