@@ -344,15 +344,18 @@ __attribute__((noinline)) bool to_steps(int32_t um, uint8_t a, int32_t& steps) {
     return num::mul_div_round(um, g_settings.axis[a].steps_per_unit, 1000000u, steps);
 }
 
-// a + b, or a - b with `subtract`; an overflow sets Block::overflow (checked once per line:
-// error:33).
-__attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = false) {
+// a + b, a - b with kSub, or a alone with kKeep; an overflow sets Block::overflow (checked once
+// per line: error:33).
+enum AddOp : uint8_t { kAdd, kSub, kKeep };
+__attribute__((noinline)) int32_t add(int32_t a, int32_t b, uint8_t subtract = kAdd) {
 #if defined(__AVR__)
     // The chip's add/adc or sub/sbc chain, whose V flag is the signed overflow: the function
-    // takes 44 bytes and about 25 cycles, the portable test below 100 bytes and about 50. (The
+    // takes 48 bytes and about 25 cycles, the portable test below 100 bytes and about 50. (The
     // simavr checks run it: fw_test_*.)
     uint8_t v = 0;
-    asm("cpse %[s], __zero_reg__\n\t"
+    asm("sbrc %[s], 1\n\t"
+        "rjmp 3f\n\t"
+        "cpse %[s], __zero_reg__\n\t"
         "rjmp 1f\n\t"
         "add %A[a], %A[b]\n\t"
         "adc %B[a], %B[b]\n\t"
@@ -374,6 +377,7 @@ __attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = fals
     return a;
 #else
     // Bit 31 of (a ^ r) & (b' ^ r) is the signed overflow of r = a + b'.
+    if (subtract == kKeep) return a;
     uint32_t ua = static_cast<uint32_t>(a), ub = static_cast<uint32_t>(b);
     if (subtract) ub = ~ub; // a - b = a + ~b + 1, and overflows as a + ~b would
     uint32_t r = ua + ub + subtract;
@@ -706,26 +710,23 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         if ((m & 1) && !length(a, b.v[a].um)) return kBadNumberFormat;
     }
     // One pass over the axes computes either the new offsets (G10, G92) or the target of a
-    // move: an axis without a word keeps `keep`, an axis with a word gets its value, turned
-    // into a machine position by `op`.
-    enum Op : uint8_t {
-        kAsIs,         // G53 (machine coordinates), G10 L2 (the value is the new G54)
-        kPlusPosition, // G91
-        kPlusOffsets,  // G90: work position + G54 + G92
-        kFromPosition, // G92, G10 L20: position - the other offset - value
-    };
+    // move: an axis without a word keeps `keep`, an axis with a word gets its value v, turned
+    // into a machine position as (x op1 st[o1]) op2 y, st[o1] an array of State in words from
+    // the position (+ kAxes: position_steps, + 2 kAxes: g54, + 3 kAxes: g92):
+    //   G53, G10 L2 (the value is the new G54): v
+    //   G91: v + position
+    //   G90: v + G54 + G92 (the work position)
+    //   G92, G10 L20: position - the other offset - v (x = position, y = v)
     bool offsets = non_modal == kSetCoordData || non_modal == kSetOffset;
     const int32_t* keep = st.position;
-    uint8_t other = 2 * kAxes; // the other offset for kFromPosition: g54 (below), or g92
-    uint8_t op = non_modal == kAbsoluteOverride ? kAsIs
-                 : b.g[kGroupDistance]          ? kPlusPosition
-                                                : kPlusOffsets;
+    uint8_t op1 = kKeep, op2 = kKeep, o1 = 0;
     if (offsets) {
         // G92: the current position becomes the given work position. G10 L20 P0|P1: the same
         // for G54; G10 L2: the given values are the new G54.
         if (axes == 0) return kNoAxisWords;
         keep = st.g92;
-        op = kFromPosition;
+        op1 = op2 = kSub;
+        o1 = 2 * kAxes; // G92: the other offset is G54
         if (non_modal == kSetCoordData) {
             if (!(b.words & bit(kWordP)) || !(b.words & bit(kWordL))) return kValueWordMissing;
             uint32_t p;
@@ -733,14 +734,20 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
             if (b.l != 2 && b.l != 20) return kUnsupportedCommand;
             if (b.l == 2) {
                 if (b.words & bit(kWordR)) return kUnsupportedCommand;
-                op = kAsIs;
+                op1 = op2 = kKeep;
             }
             b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
             keep = st.g54;
-            other = 3 * kAxes;
+            o1 = 3 * kAxes; // and G92 for G10 L20
         }
-    } else if (non_modal == kAbsoluteOverride && motion > Motion::Linear) {
-        return kG53InvalidMotionMode;
+    } else if (non_modal == kAbsoluteOverride) {
+        if (motion > Motion::Linear) return kG53InvalidMotionMode;
+    } else {
+        op1 = kAdd;
+        if (!b.g[kGroupDistance]) {
+            op2 = kAdd;
+            o1 = 2 * kAxes;
+        }
     }
     motion::LineRequest& req = work().req;
     static_assert(offsetof(State, position_steps) == offsetof(State, position) + 4 * kAxes &&
@@ -758,14 +765,12 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
             // g54, + 3 kAxes: g92) and req's target_steps (+ kAxes: target_um).
             const int32_t* const sa = st.position + a;
             int32_t* const ra = req.target_steps + a;
-            int32_t t = b.v[a].um;
-            if (op == kPlusPosition) {
-                t = add(t, sa[0]);
-            } else if (op == kPlusOffsets) {
-                t = add(add(t, sa[2 * kAxes]), sa[3 * kAxes]);
-            } else if (op == kFromPosition) {
-                t = add(add(sa[0], sa[other], true), t, true);
+            int32_t x = b.v[a].um, y = sa[3 * kAxes];
+            if (op1 == kSub) { // G92, G10 L20
+                y = x;
+                x = sa[0];
             }
+            int32_t t = add(add(x, sa[o1], op1), y, op2);
             ra[kAxes] = t;
             // Always from the absolute target: no rounding error accumulates. One move travels
             // at most kMaxLineTicks steps per axis (line.h).
