@@ -502,7 +502,19 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
         }
         int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], false, c.turns);
         // 0 <= sweep < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r sweep.
-        uint32_t q21 = static_cast<uint32_t>(sweep >> 8);
+        uint32_t q21;
+#if defined(__AVR__)
+        // Bytes 1 to 4 by moves: avr-gcc would call its 64-bit shift, which nothing else in the
+        // image needs (__ashrdi3 and __lshrdi3: 60 B).
+        asm("mov %A0, %B1\n\t"
+            "mov %B0, %C1\n\t"
+            "mov %C0, %D1\n\t"
+            "mov %D0, %r1+4"
+            : "=&r"(q21)
+            : "r"(sweep));
+#else
+        q21 = static_cast<uint32_t>(sweep >> 8);
+#endif
         reach.set(q21, -21).mul(radii[0] > radii[1] ? radii[0] : radii[1]);
     }
     reach.add(Num(abs32(add(work().req.target_um[ax[2]], g_state.position[ax[2]], true))));
