@@ -700,16 +700,16 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
 
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
     if (b.words & bit(kWordF)) {
-        int32_t f;
-        if (!length(kWordF, f)) return kBadNumberFormat;
-        b.feed = static_cast<uint32_t>(f);
+        // (Straight into the block: a line rejected here never reaches stage 4.)
+        if (!length(kWordF, *reinterpret_cast<int32_t*>(&b.feed))) return kBadNumberFormat;
     }
 
-    // [10] Dwell: P seconds.
-    int32_t dwell_ms = 0;
+    // [10] Dwell: P seconds (the outcome's dwell_ms only counts with kDwell).
     if (non_modal == kDwellCmd) {
         if (!(b.words & bit(kWordP))) return kValueWordMissing;
-        if (!num::to_milli(b.v[kWordP].d, dwell_ms)) return kBadNumberFormat;
+        if (!num::to_milli(b.v[kWordP].d, *reinterpret_cast<int32_t*>(&outcome.dwell_ms))) {
+            return kBadNumberFormat;
+        }
         b.words = static_cast<WordMask>(b.words & ~bit(kWordP));
     }
 
@@ -823,10 +823,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     bool check = (flags & kCheckMode) != 0;
     bool moves = b.axis_command == kAxisMotion;
     if (!check) {
-        if (non_modal == kDwellCmd && !(flags & kDwellDone)) {
-            outcome.dwell_ms = static_cast<uint32_t>(dwell_ms);
-            return kDwell;
-        }
+        if (non_modal == kDwellCmd && !(flags & kDwellDone)) return kDwell;
         if ((offsets || non_modal == kResetOffset) && motion::state() != motion::State::Idle) {
             return kRetryWhenIdle;
         }
