@@ -717,44 +717,31 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     if (b.g[kGroupCoord] != 0) return kUnsupportedCoordSys;
 
     // [19] The axis words in um, then the non-modal commands that use them, or the target.
-    for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
-        // In place: length_to_milli() has read the number when it writes the um.
-        if ((m & 1) && !length(a, b.v[a].um)) return kBadNumberFormat;
-    }
-    // One pass over the axes computes either the new offsets (G10, G92) or the target of a
-    // move: an axis without a word keeps `keep`, an axis with a word gets its value v, turned
-    // into a machine position as (x op1 st[o1]) op2 y, st[o1] an array of State in words from
-    // the position (+ kAxes: position_steps, + 2 kAxes: g54, + 3 kAxes: g92):
+    // One pass over the axes converts each word and computes either the new offsets (G10, G92)
+    // or the target of a move: an axis without a word keeps `keep`, an axis with a word gets its
+    // value v, turned into a machine position as (x op1 st[o1]) op2 y, st[o1] an array of State
+    // in words from the position (+ kAxes: position_steps, + 2 kAxes: g54, + 3 kAxes: g92):
     //   G53, G10 L2 (the value is the new G54): v
     //   G91: v + position
     //   G90: v + G54 + G92 (the work position)
     //   G92, G10 L20: position - the other offset - v (x = position, y = v)
+    // The commands' own checks follow the pass, and its overflow them, in GRBL's order: a bad
+    // number first, then the command, then the target.
     bool offsets = non_modal == kSetCoordData || non_modal == kSetOffset;
     const int32_t* keep = st.position;
     uint8_t op1 = kKeep, op2 = kKeep, o1 = 0;
     if (offsets) {
         // G92: the current position becomes the given work position. G10 L20 P0|P1: the same
         // for G54; G10 L2: the given values are the new G54.
-        if (axes == 0) return kNoAxisWords;
         keep = st.g92;
         op1 = op2 = kSub;
         o1 = 2 * kAxes; // G92: the other offset is G54
         if (non_modal == kSetCoordData) {
-            if (!(b.words & bit(kWordP)) || !(b.words & bit(kWordL))) return kValueWordMissing;
-            uint32_t p;
-            if (!num::to_uint(b.v[kWordP].d, 1u, p)) return kUnsupportedCoordSys;
-            if (b.l != 2 && b.l != 20) return kUnsupportedCommand;
-            if (b.l == 2) {
-                if (b.words & bit(kWordR)) return kUnsupportedCommand;
-                op1 = op2 = kKeep;
-            }
-            b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
+            if (b.l == 2) op1 = op2 = kKeep;
             keep = st.g54;
             o1 = 3 * kAxes; // and G92 for G10 L20
         }
-    } else if (non_modal == kAbsoluteOverride) {
-        if (motion > Motion::Linear) return kG53InvalidMotionMode;
-    } else {
+    } else if (non_modal != kAbsoluteOverride) {
         op1 = kAdd;
         if (!b.g[kGroupDistance]) {
             op2 = kAdd;
@@ -768,33 +755,51 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
                       offsetof(motion::LineRequest, target_um) ==
                           offsetof(motion::LineRequest, target_steps) + 4 * kAxes,
                   "the arrays of axes in a row");
+    // (Axis words always have a user here: [0] gave them to the motion mode, or G10 / G92 took
+    // them.)
     if (offsets || b.axis_command == kAxisMotion) {
         copy_words(req.target_um, keep, kAxes); // for G10 / G92: the new offsets
         copy_words(req.target_steps, st.position_steps, kAxes);
         for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
             if (!(m & 1)) continue;
+            // In place: length_to_milli() has read the number when it writes the um.
+            if (!length(a, b.v[a].um)) return kBadNumberFormat;
             // Axis a of the arrays in a row: st's position (+ kAxes: position_steps, + 2 kAxes:
             // g54, + 3 kAxes: g92) and req's target_steps (+ kAxes: target_um).
             const int32_t* const sa = st.position + a;
             int32_t* const ra = req.target_steps + a;
-            int32_t x = b.v[a].um, y = sa[3 * kAxes];
+            const int32_t *x = &b.v[a].um, *y = sa + 3 * kAxes;
             if (op1 == kSub) { // G92, G10 L20
                 y = x;
-                x = sa[0];
+                x = sa;
             }
-            int32_t t = add(add(x, sa[o1], op1), y, op2);
+            int32_t t = add(add(*x, sa[o1], op1), *y, op2);
             ra[kAxes] = t;
             // Always from the absolute target: no rounding error accumulates. One move travels
             // at most kMaxLineTicks steps per axis (line.h).
             if (!offsets &&
+                // (|d| > max as one unsigned comparison: d + max wraps above 2 max.)
                 (!to_steps(t, a, ra[0]) ||
-                 abs32(static_cast<int32_t>(static_cast<uint32_t>(ra[0]) -
-                                            static_cast<uint32_t>(sa[kAxes]))) > kMaxLineTicks)) {
+                 static_cast<uint32_t>(ra[0]) - static_cast<uint32_t>(sa[kAxes]) + kMaxLineTicks >
+                     2u * kMaxLineTicks)) {
                 b.overflow = 1;
             }
         }
-        if (b.overflow) return kInvalidTarget;
     }
+    if (offsets) {
+        if (axes == 0) return kNoAxisWords;
+        if (non_modal == kSetCoordData) {
+            if (!(b.words & bit(kWordP)) || !(b.words & bit(kWordL))) return kValueWordMissing;
+            uint32_t p;
+            if (!num::to_uint(b.v[kWordP].d, 1u, p)) return kUnsupportedCoordSys;
+            if (b.l != 2 && b.l != 20) return kUnsupportedCommand;
+            if (b.l == 2 && (b.words & bit(kWordR))) return kUnsupportedCommand;
+            b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
+        }
+    } else if (non_modal == kAbsoluteOverride && motion > Motion::Linear) {
+        return kG53InvalidMotionMode;
+    }
+    if (b.overflow) return kInvalidTarget;
 
     // [20] Motion modes.
     bool curve = false;
