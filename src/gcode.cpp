@@ -493,10 +493,9 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
             ellipse_direction(p[0], p[1], radii, cse[0], cse[1]);
             for (uint8_t k = 0; k < 2; ++k) {
                 uint32_t on = Num(abs32(cse[k]), -30).mul(radii[k]).u32(); // r |cs| (Q30)
-                // p - sign(cs) on, as sign(cs) (sign(cs) p - on): the same magnitude.
-                uint32_t d = static_cast<uint32_t>(p[k]);
-                if (cse[k] < 0) d = 0u - d;
-                d -= on;
+                // p - sign(cs) on, as |p| - on: the same magnitude (cs has the sign of p, or is
+                // 0: ellipse_direction() scales |p| and then gives it p's sign).
+                uint32_t d = abs32(p[k]) - on;
                 if (ellipse && abs32(static_cast<int32_t>(d)) > gap_um) return false;
             }
         }
