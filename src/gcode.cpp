@@ -465,7 +465,9 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
         uint8_t a = ax[i & 1];
         uint32_t spu = g_settings.axis[a].steps_per_unit;
         if (spu < spu_min) spu_min = spu;
-        if (!to_steps(row[i], a, steps) || abs32(steps) > (1l << 22)) {
+        // (|steps| > 2^22 as one unsigned comparison: steps + 2^22 wraps above 2^23.)
+        if (!to_steps(row[i], a, steps) ||
+            static_cast<uint32_t>(steps) + (1ul << 22) > (1ul << 23)) {
             return false;
         }
     }
