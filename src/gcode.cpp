@@ -697,7 +697,9 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         return kNegativeValue;
     }
     // (N is 0 without the word, at most 10000000 when valid, else kNoLineNumber: its top bit.)
-    if (b.n >> 31) return kInvalidLineNumber;
+    // (Its top byte: both the chip and the host are little-endian.)
+    static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "N's top byte is its last");
+    if (reinterpret_cast<const uint8_t*>(&b.n)[3] & 0x80) return kInvalidLineNumber;
 
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
     if (b.words & bit(kWordF)) {
