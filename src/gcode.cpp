@@ -793,8 +793,9 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         if (axes == 0) return kNoAxisWords;
         if (non_modal == kSetCoordData) {
             if (!(b.words & bit(kWordP)) || !(b.words & bit(kWordL))) return kValueWordMissing;
-            uint32_t p;
-            if (!num::to_uint(b.v[kWordP].d, 1u, p)) return kUnsupportedCoordSys;
+            // (The value over the number's integer part, which it is when valid: no local.)
+            num::Decimal& p = b.v[kWordP].d;
+            if (!num::to_uint(p, 1u, p.ipart)) return kUnsupportedCoordSys;
             if (b.l != 2 && b.l != 20) return kUnsupportedCommand;
             if (b.l == 2 && (b.words & bit(kWordR))) return kUnsupportedCommand;
             b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
