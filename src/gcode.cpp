@@ -23,11 +23,13 @@ namespace {
 using namespace status;
 
 // Modal groups (NIST RS274NGC table 4; GRBL's numbering in the comments). A block keeps the
-// value each command gives its group in Block::g[group]: 0 is the non-modal command, 1 to 7 are
-// the bytes of Modal in order, 8 the program flow. The groups from kGroupArcDistance on have one
-// command each that changes nothing: they only count for error:21.
+// value each command gives its group in Block::g[group]: 0 is the program flow, 1 to 7 are the
+// bytes of Modal in order, then T and L (not groups: the bytes after Modal, as State::tool
+// follows State::modal, so that Modal and the tool are copied as two words), 10 the non-modal
+// command. The groups from kGroupArcDistance on have one command each that changes nothing:
+// they only count for error:21.
 enum Group : uint8_t {
-    kGroupNonModal,    // G4 G10 G53 G92 G92.1 (G0)
+    kGroupFlow,        // M0 M1 M2 M30 (M4)
     kGroupMotion,      // G0 G1 G80, later G2 G3 G2.1 G3.1 G5 (G1)
     kGroupPlane,       // G17 G18 G19 (G2)
     kGroupUnits,       // G20 G21 (G6)
@@ -35,7 +37,9 @@ enum Group : uint8_t {
     kGroupCoord,       // G54..G59 (G12)
     kGroupSpindle,     // M3 M4 M5 (M7)
     kGroupCoolant,     // M8 M9 (M8)
-    kGroupFlow,        // M0 M1 M2 M30 (M4)
+    kBlockTool,        // (T, Block::g's byte after Modal's)
+    kBlockL,           // (L, 0xFF when not an integer 0..254)
+    kGroupNonModal,    // G4 G10 G53 G92 G92.1 (G0)
     kGroupArcDistance, // G91.1 (G4)
     kGroupFeedMode,    // G94 (G5)
     kGroupCutter,      // G40 (G7)
@@ -61,7 +65,11 @@ enum NonModal : uint8_t {
 };
 
 // Which command uses the axis words of the block (GRBL's AXIS_COMMAND_*).
-enum AxisCommand : uint8_t { kAxisNone, kAxisNonModal, kAxisMotion };
+enum AxisCommand : uint8_t {
+    kAxisNone,
+    kAxisMotion = kGroupMotion + 1,
+    kAxisNonModal = kGroupNonModal + 1,
+};
 
 enum Flow : uint8_t { kFlowRunning, kFlowPause, kFlowEnd };
 
@@ -192,11 +200,9 @@ union Slot {
 };
 
 struct Block {
-    uint8_t g[kGroupFlow + 1]; // the value of each group with a value (see Group)
+    uint8_t g[kGroupNonModal + 1]; // the value of each group with a value, T and L (see Group)
     uint8_t axis_command;
     uint8_t overflow; // an offset or target does not fit an int32 (see add())
-    uint8_t l;        // L, 0xFF when not an integer 0..254
-    uint8_t tool;     // T (l and tool in a row, as kWordL and kWordT)
     uint16_t groups;  // modal groups commanded in this block
     WordMask words;   // value words present, bit(Word)
     // As State::feed, spindle_speed and line_number (copied as one).
@@ -213,7 +219,6 @@ struct Block {
 };
 static_assert(sizeof(CurveParams) <= kWordP * sizeof(Slot),
               "the curve overlays the axis and F slots only");
-static_assert(offsetof(Block, tool) == offsetof(Block, l) + 1, "L and T in a row");
 static_assert(offsetof(Block, n) - offsetof(Block, feed) ==
                   offsetof(State, line_number) - offsetof(State, feed),
               "feed, S and N are laid out as in State");
@@ -303,7 +308,7 @@ uint8_t import_command(Block& b, uint8_t m, const num::Decimal& d) {
     uint16_t gbit = static_cast<uint16_t>(1u << group);
     if (b.groups & gbit) return kModalGroupViolation;
     b.groups |= gbit;
-    if (group <= kGroupFlow) b.g[group] = value & 0x0F;
+    if (group <= kGroupNonModal) b.g[group] = value & 0x0F; // (never kBlockTool, kBlockL)
     return kOk;
 }
 
@@ -327,7 +332,7 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
         if (word == kWordN) {
             b.n = v;
         } else {
-            (&b.l)[word - kWordL] = static_cast<uint8_t>(v); // L, T: Block::l, tool
+            b.g[kBlockL + kWordL - word] = static_cast<uint8_t>(v); // L, T
         }
     }
     return kOk;
@@ -467,7 +472,8 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
         if (spu < spu_min) spu_min = spu;
         // (|steps| > 2^22 as one unsigned comparison: steps + 2^22 wraps above 2^23.)
         if (!to_steps(row[i], a, steps) ||
-            static_cast<uint32_t>(steps) + (1ul << 22) > (1ul << 23)) {
+            static_cast<uint32_t>(static_cast<uint32_t>(steps) + (uint32_t(1) << 22)) >
+                (uint32_t(1) << 23)) {
             return false;
         }
     }
@@ -651,14 +657,13 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
 
     // ---- Stage 1: a block that starts from the current modes.
     Block& b = opaque(work().b);
-    static_assert(offsetof(State, tool) == sizeof(Modal) && sizeof(Modal) + 1 == 8,
-                  "modal and tool are two words");
+    static_assert(offsetof(State, tool) == sizeof(Modal) && sizeof(Modal) + 1 == 8 &&
+                      kBlockTool == kGroupMotion + sizeof(Modal),
+                  "modal and tool are two words, in the state and in the block");
     static_assert(kNoNonModal == 0 && kFlowRunning == 0 && kAxisNone == 0, "a header of zeros");
     memset(&b, 0, offsetof(Block, v));            // and N
-    copy_words(&b.g[kGroupMotion], &st.modal, 2); // and the tool into the flow byte:
-    b.tool = b.g[kGroupFlow];
-    b.g[kGroupFlow] = kFlowRunning;
-    b.l = 0xFF;
+    copy_words(&b.g[kGroupMotion], &st.modal, 2); // and the tool
+    b.g[kBlockL] = 0xFF;
     copy_words(&b.feed, &st.feed, 2); // and S
 
     // ---- Stage 2: import every word (letter + number), checking repeats, modal groups and
@@ -740,7 +745,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         op1 = op2 = kSub;
         o1 = 2 * kAxes; // G92: the other offset is G54
         if (non_modal == kSetCoordData) {
-            if (b.l == 2) op1 = op2 = kKeep;
+            if (b.g[kBlockL] == 2) op1 = op2 = kKeep;
             keep = st.g54;
             o1 = 3 * kAxes; // and G92 for G10 L20
         }
@@ -796,8 +801,9 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
             // (The value over the number's integer part, which it is when valid: no local.)
             num::Decimal& p = b.v[kWordP].d;
             if (!num::to_uint(p, 1u, p.ipart)) return kUnsupportedCoordSys;
-            if (b.l != 2 && b.l != 20) return kUnsupportedCommand;
-            if (b.l == 2 && (b.words & bit(kWordR))) return kUnsupportedCommand;
+            uint8_t l = b.g[kBlockL];
+            if (l != 2 && l != 20) return kUnsupportedCommand;
+            if (l == 2 && (b.words & bit(kWordR))) return kUnsupportedCommand;
             b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
         }
     } else if (non_modal == kAbsoluteOverride && motion > Motion::Linear) {
@@ -842,9 +848,8 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     }
 
     // ---- Stage 4: execute, in GRBL's order.
-    copy_words(&st.modal, &b.g[kGroupMotion], 2); // coord: 0, checked above; the tool:
-    st.tool = b.tool;
-    copy_words(&st.feed, &b.feed, 3); // and S, N
+    copy_words(&st.modal, &b.g[kGroupMotion], 2); // coord: 0, checked above; and the tool
+    copy_words(&st.feed, &b.feed, 3);             // and S, N
     if (offsets) {
         bool g10 = non_modal == kSetCoordData;
         copy_words(g10 ? st.g54 : st.g92, req.target_um, kAxes);
