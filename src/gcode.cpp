@@ -349,16 +349,17 @@ __attribute__((noinline)) bool to_steps(int32_t um, uint8_t a, int32_t& steps) {
     return num::mul_div_round(um, g_settings.axis[a].steps_per_unit, 1000000u, steps);
 }
 
-// a + b, a - b with kSub, or a alone with kKeep; an overflow sets Block::overflow (checked once
+// a + b, a - b with kSub (or any other value but 0 and kKeep: combine2()'s ops), or a alone with
+// kKeep; an overflow sets Block::overflow (checked once
 // per line: error:33).
-enum AddOp : uint8_t { kAdd, kSub, kKeep };
+enum AddOp : uint8_t { kAdd, kSub, kKeep = 4 };
 __attribute__((noinline)) int32_t add(int32_t a, int32_t b, uint8_t subtract = kAdd) {
 #if defined(__AVR__)
     // The chip's add/adc or sub/sbc chain, whose V flag is the signed overflow: the function
     // takes 48 bytes and about 25 cycles, the portable test below 100 bytes and about 50. (The
     // simavr checks run it: fw_test_*.)
     uint8_t v = 0;
-    asm("sbrc %[s], 1\n\t"
+    asm("sbrc %[s], 2\n\t"
         "rjmp 3f\n\t"
         "cpse %[s], __zero_reg__\n\t"
         "rjmp 1f\n\t"
@@ -385,7 +386,7 @@ __attribute__((noinline)) int32_t add(int32_t a, int32_t b, uint8_t subtract = k
     if (subtract == kKeep) return a;
     uint32_t ua = static_cast<uint32_t>(a), ub = static_cast<uint32_t>(b);
     if (subtract) ub = ~ub; // a - b = a + ~b + 1, and overflows as a + ~b would
-    uint32_t r = ua + ub + subtract;
+    uint32_t r = ua + ub + (subtract != kAdd);
     if (((ua ^ r) & (ub ^ r)) >> 31) work().b.overflow = 1;
     return static_cast<int32_t>(r);
 #endif
@@ -415,12 +416,13 @@ void set_end_modes(Modal& m) {
 }
 
 // Two points of the plane combined per coordinate: p - q, |p - q| (kMagnitudes, as uint32_t: 2^31
-// for INT32_MIN) or p + q (kSum). An overflow flags the block, as add() does.
-enum Op2 : uint8_t { kDifference, kMagnitudes, kSum };
+// for INT32_MIN) or p + q (kSum). An overflow flags the block, as add() does. (add() takes the op:
+// kSum adds, the others subtract.)
+enum Op2 : uint8_t { kSum = kAdd, kDifference = kSub, kMagnitudes = 2 };
 __attribute__((noinline)) void combine2(int32_t out[2], const int32_t p[2], const int32_t q[2],
                                         uint8_t op = kDifference) {
     for (uint8_t k = 0; k < 2; ++k) {
-        int32_t v = add(p[k], q[k], op != kSum);
+        int32_t v = add(p[k], q[k], op);
         out[k] = op == kMagnitudes ? static_cast<int32_t>(abs32(v)) : v;
     }
 }
