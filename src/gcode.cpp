@@ -895,11 +895,24 @@ bool reset() {
     return ok;
 }
 
-void steps_to_um(const int32_t* steps, int32_t* um) {
+namespace {
+// Every axis between steps and um, in one loop for both ways: to um, um = steps x 10^6 / spu
+// (saturated on overflow); to steps, steps = um x spu / 10^6, written only when it fits.
+__attribute__((noinline)) void convert_axes(const int32_t* from, int32_t* to, bool to_um) {
     const AxisSettings* s = g_settings.axis;
-    for (uint8_t a = kAxes; a != 0; --a) {
-        num::mul_div_round(*steps++, 1000000u, (s++)->steps_per_unit, *um++);
+    for (uint8_t a = kAxes; a != 0; --a, ++to) {
+        uint32_t spu = (s++)->steps_per_unit;
+        int32_t v;
+        if (num::mul_div_round(*from++, to_um ? 1000000u : spu, to_um ? spu : 1000000u, v) ||
+            to_um) {
+            *to = v;
+        }
     }
+}
+} // namespace
+
+void steps_to_um(const int32_t* steps, int32_t* um) {
+    convert_axes(steps, um, true);
 }
 
 void sync_position() {
@@ -908,12 +921,7 @@ void sync_position() {
 }
 
 void settings_changed() {
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        int32_t steps;
-        if (to_steps(g_state.position[a], a, steps)) {
-            g_state.position_steps[a] = steps;
-        }
-    }
+    convert_axes(g_state.position, g_state.position_steps, false);
 }
 
 void work_offset(int32_t (&um)[kAxes]) {
