@@ -534,9 +534,13 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
 // extensions' (ellipses, G5), and the geometry handed to the planner. Consumes its words.
 __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t axes,
                                               const State& st, CurveParams& c) {
-    uint8_t ax[3];
+    // The plane's axes, then (in place of the normal axis, which this function does not use)
+    // P's and Q's distances from I: the four words of the loop below as kWordI + ax[k].
+    uint8_t ax[4];
     const uint8_t plane = c.plane = b.g[kGroupPlane];
     axes_of(plane, ax);
+    ax[2] = static_cast<uint8_t>(kWordP - kWordI); // (wraps: kWordI + it is kWordP)
+    ax[3] = kWordQ - kWordI;
     // The normal of plane p is axis 2 - p (plane_axes), so the plane's axes are X Y Z but it.
     // (7 ^ (4 >> plane): 3, 5, 6, computed without a shift loop)
     const uint8_t in_plane = static_cast<uint8_t>(3 + 2 * plane - (plane >> 1));
@@ -554,7 +558,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     int32_t* const o = c.a_um;
     bool pq_not_positive = false; // an ellipse's semi-axes must be above 0
     for (uint8_t k = 0; k < 4; ++k) {
-        uint8_t word = static_cast<uint8_t>(k < 2 ? kWordI + ax[k] : k == 2 ? kWordP : kWordQ);
+        uint8_t word = static_cast<uint8_t>(kWordI + ax[k]);
         o[k] = 0;
         if ((b.words & bit(word)) && !length(word, o[k])) return kBadNumberFormat;
         if (k >= 2 && o[k] <= 0) pq_not_positive = true;
