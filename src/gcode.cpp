@@ -640,8 +640,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             if (delta > 5 && (delta > 500 || delta * 1000u > r)) return kInvalidTarget;
         }
         if (r == 0) return kInvalidTarget;
-        c.b_um[0] = static_cast<int32_t>(r);
-        c.b_um[1] = static_cast<int32_t>(r);
+        int32_t* radii = opaque(c.b_um); // (through a pointer: no absolute stores)
+        radii[0] = radii[1] = static_cast<int32_t>(r);
         if (b.words & bit(kWordP)) { // LinuxCNC: P turns, P1 the plain arc
             uint32_t turns;
             if (!num::to_uint(b.v[kWordP].d, 256u, turns)) return kCommandValueNotInteger;
