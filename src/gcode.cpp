@@ -474,10 +474,11 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
         uint8_t a = ax[i & 1];
         uint32_t spu = g_settings.axis[a].steps_per_unit;
         if (spu < spu_min) spu_min = spu;
-        // (|steps| > 2^22 as one unsigned comparison: steps + 2^22 wraps above 2^23.)
-        if (!to_steps(row[i], a, steps) ||
-            static_cast<uint32_t>(static_cast<uint32_t>(steps) + (uint32_t(1) << 22)) >
-                (uint32_t(1) << 23)) {
+        // (|steps| > 2^22 as one unsigned comparison: steps + 2^22 wraps above 2^23. A result
+        // out of the int32 range is saturated to +-(2^31 - 1): out of this one too.)
+        to_steps(row[i], a, steps);
+        if (static_cast<uint32_t>(static_cast<uint32_t>(steps) + (uint32_t(1) << 22)) >
+            (uint32_t(1) << 23)) {
             return false;
         }
     }
