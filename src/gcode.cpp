@@ -428,12 +428,13 @@ __attribute__((noinline)) void combine2(int32_t out[2], const int32_t p[2], cons
 }
 
 // |p - q| for two points of the plane, um.
-// (Into the caller's Num: returned, it would be copied through registers twice.)
-__attribute__((noinline)) void dist_um(const int32_t p[2], const int32_t q[2], Num& out) {
+// (Into the caller's Num: returned, it would be copied through registers twice.) Returns its
+// floor.
+__attribute__((noinline)) uint32_t dist_um(const int32_t p[2], const int32_t q[2], Num& out) {
     uint32_t v[2];
     combine2(reinterpret_cast<int32_t*>(v), p, q, kMagnitudes);
     out = sum_squares(v, 2);
-    out.sqrt();
+    return out.sqrt().u32();
 }
 
 // plane_axes() as a rotation: (u, v, w) = axes (k - plane) mod 3.
@@ -636,12 +637,9 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     if (!ellipse && !bezier) {
         if (!(b.words & bit(kWordR))) {
             // The end must be on the circle: within 0.005 mm, or else within 0.5 mm and 0.1 %.
-            Num rn;
-            dist_um(c.start_um, c.a_um, rn);
-            r = rn.u32();
-            Num re;
-            dist_um(c.end_um, c.a_um, re);
-            uint32_t x = re.u32(), delta = x > r ? x - r : r - x;
+            Num t;
+            r = dist_um(c.start_um, c.a_um, t);
+            uint32_t x = dist_um(c.end_um, c.a_um, t), delta = x > r ? x - r : r - x;
             // (delta > r / 1000 as delta * 1000 > r: the same for integers, delta <= 500.)
             if (delta > 5 && (delta > 500 || delta * 1000u > r)) return kInvalidTarget;
         }
