@@ -235,6 +235,8 @@ struct Work {
         motion::LineRequest req;
     };
 };
+static_assert(offsetof(Work, other) == offsetof(Work, b) + offsetof(Block, v) + sizeof(Block::v),
+              "Work::other is the slot past the block's last one");
 // In the motion side's scratch RAM (motion.h: it is ours from execute() until push_line()).
 static_assert(sizeof(void*) != 2 || sizeof(Work) == motion::kScratchBytes,
               "motion::kScratchBytes is the size of the work block on the AVR");
@@ -682,7 +684,9 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         char letter = *line++;
         if (letter < 'A' || letter > 'Z') return kExpectedCommandLetter;
         uint8_t word = flash_read_byte(&kLetterInfo[letter - 'A']);
-        num::Decimal& d = word < kDecimalSlots ? b.v[word].d : work().other;
+        // Its slot, or Work::other for the other letters: the slot past the last one.
+        Slot* const slots = b.v; // (a pointer: indexing the array past its end is undefined)
+        num::Decimal& d = slots[word < kDecimalSlots ? word : kDecimalSlots].d;
         line = num::parse(line, d);
         if (line == nullptr) return kBadNumberFormat;
         uint8_t r = kUnsupportedCommand;
