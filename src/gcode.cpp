@@ -532,7 +532,16 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
 #endif
         reach.set(q21, -21).mul(radii[0] > radii[1] ? radii[0] : radii[1]);
     }
-    reach.add(Num(abs32(add(work().req.target_um[ax[2]], g_state.position[ax[2]], true))));
+    // The normal axis' travel: |target - position| as the first of a pair (the second, the next
+    // axis' or the words after the arrays, is not used).
+    static_assert(offsetof(State, position) + 4 * 4 <= sizeof(State) &&
+                      offsetof(motion::LineRequest, target_um) + 4 * 4 <=
+                          sizeof(motion::LineRequest),
+                  "the pair of the normal axis (2 at most) lies within the state and the request");
+    uint32_t w[2];
+    combine2(reinterpret_cast<int32_t*>(w), work().req.target_um + ax[2], g_state.position + ax[2],
+             kMagnitudes);
+    reach.add(Num(w[0]));
     return reach.u32() < (1ul << 23); // (floor(x) < 2^23 exactly when x < 2^23)
 }
 
