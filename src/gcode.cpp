@@ -343,7 +343,10 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
 // The length word `word` of the block (its slot), in the units of the block, to um (or a feed to
 // mm/min x1000).
 __attribute__((noinline)) bool length(uint8_t word, int32_t& out) {
-    return num::length_to_milli(work().b.v[word].d, work().b.g[kGroupUnits] != 0, out);
+    static_assert(sizeof(bool) == 1, "a bool is a byte");
+    bool inches; // (the byte is 0 or 1 already: copied, not tested)
+    memcpy(&inches, &work().b.g[kGroupUnits], 1);
+    return num::length_to_milli(work().b.v[word].d, inches, out);
 }
 
 // um along axis a to steps, rounded (false when out of the int32 range).
