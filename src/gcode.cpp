@@ -964,7 +964,7 @@ void report_modes() {
     out::word('G', static_cast<uint8_t>(17u + m.plane));
     out::word('G', static_cast<uint8_t>(21u - m.inches));
     out::word('G', static_cast<uint8_t>(90u + m.incremental));
-    out::str(LL_PSTR(" G94"));
+    out::word('G', 94);
     out::word('M', m.spindle);
     out::word('M', m.coolant);
     out::word('T', g_state.tool);
