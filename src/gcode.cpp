@@ -754,7 +754,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     // One pass over the axes converts each word and computes either the new offsets (G10, G92)
     // or the target of a move: an axis without a word keeps `keep`, an axis with a word gets its
     // value v, turned into a machine position as (x op1 st[o1]) op2 y, st[o1] an array of State
-    // in words from the position (+ kAxes: position_steps, + 2 kAxes: g54, + 3 kAxes: g92):
+    // o1 bytes from the position (+ 4 kAxes: position_steps, + 8 kAxes: g54, + 12 kAxes: g92):
     //   G53, G10 L2 (the value is the new G54): v
     //   G91: v + position
     //   G90: v + G54 + G92 (the work position)
@@ -769,17 +769,17 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         // for G54; G10 L2: the given values are the new G54.
         keep = st.g92;
         op1 = op2 = kSub;
-        o1 = 2 * kAxes; // G92: the other offset is G54
+        o1 = 2 * kAxes * 4; // G92: the other offset is G54
         if (non_modal == kSetCoordData) {
             if (b.g[kBlockL] == 2) op1 = op2 = kKeep;
             keep = st.g54;
-            o1 = 3 * kAxes; // and G92 for G10 L20
+            o1 = 3 * kAxes * 4; // and G92 for G10 L20
         }
     } else if (non_modal != kAbsoluteOverride) {
         op1 = kAdd;
         if (!b.g[kGroupDistance]) {
             op2 = kAdd;
-            o1 = 2 * kAxes;
+            o1 = 2 * kAxes * 4;
         }
     }
     motion::LineRequest& req = work().req;
@@ -807,7 +807,12 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
                 y = x;
                 x = sa;
             }
-            int32_t t = add(add(*x, sa[o1], op1), *y, op2);
+            // (o1 in bytes: no shift an axis)
+            int32_t t = add(
+                add(*x,
+                    *reinterpret_cast<const int32_t*>(reinterpret_cast<const uint8_t*>(sa) + o1),
+                    op1),
+                *y, op2);
             ra[kAxes] = t;
             // Always from the absolute target: no rounding error accumulates. One move travels
             // at most kMaxLineTicks steps per axis (line.h).
