@@ -23,11 +23,13 @@ namespace {
 using namespace status;
 
 // Modal groups (NIST RS274NGC table 4; GRBL's numbering in the comments). A block keeps the
-// value each command gives its group in Block::g[group]: 0 is the non-modal command, 1 to 7 are
-// the bytes of Modal in order, 8 the program flow. The groups from kGroupArcDistance on have one
-// command each that changes nothing: they only count for error:21.
+// value each command gives its group in Block::g[group]: 0 is the program flow, 1 to 7 are the
+// bytes of Modal in order, then T and L (not groups: the bytes after Modal, as State::tool
+// follows State::modal, so that Modal and the tool are copied as two words), 10 the non-modal
+// command. The groups from kGroupArcDistance on have one command each that changes nothing:
+// they only count for error:21.
 enum Group : uint8_t {
-    kGroupNonModal,    // G4 G10 G53 G92 G92.1 (G0)
+    kGroupFlow,        // M0 M1 M2 M30 (M4)
     kGroupMotion,      // G0 G1 G80, later G2 G3 G2.1 G3.1 G5 (G1)
     kGroupPlane,       // G17 G18 G19 (G2)
     kGroupUnits,       // G20 G21 (G6)
@@ -35,7 +37,9 @@ enum Group : uint8_t {
     kGroupCoord,       // G54..G59 (G12)
     kGroupSpindle,     // M3 M4 M5 (M7)
     kGroupCoolant,     // M8 M9 (M8)
-    kGroupFlow,        // M0 M1 M2 M30 (M4)
+    kBlockTool,        // (T, Block::g's byte after Modal's)
+    kBlockL,           // (L, 0xFF when not an integer 0..254)
+    kGroupNonModal,    // G4 G10 G53 G92 G92.1 (G0)
     kGroupArcDistance, // G91.1 (G4)
     kGroupFeedMode,    // G94 (G5)
     kGroupCutter,      // G40 (G7)
@@ -61,7 +65,11 @@ enum NonModal : uint8_t {
 };
 
 // Which command uses the axis words of the block (GRBL's AXIS_COMMAND_*).
-enum AxisCommand : uint8_t { kAxisNone, kAxisNonModal, kAxisMotion };
+enum AxisCommand : uint8_t {
+    kAxisNone,
+    kAxisMotion = kGroupMotion + 1,
+    kAxisNonModal = kGroupNonModal + 1,
+};
 
 enum Flow : uint8_t { kFlowRunning, kFlowPause, kFlowEnd };
 
@@ -192,11 +200,9 @@ union Slot {
 };
 
 struct Block {
-    uint8_t g[kGroupFlow + 1]; // the value of each group with a value (see Group)
+    uint8_t g[kGroupNonModal + 1]; // the value of each group with a value, T and L (see Group)
     uint8_t axis_command;
     uint8_t overflow; // an offset or target does not fit an int32 (see add())
-    uint8_t l;        // L, 0xFF when not an integer 0..254
-    uint8_t tool;     // T (l and tool in a row, as kWordL and kWordT)
     uint16_t groups;  // modal groups commanded in this block
     WordMask words;   // value words present, bit(Word)
     // As State::feed, spindle_speed and line_number (copied as one).
@@ -213,7 +219,6 @@ struct Block {
 };
 static_assert(sizeof(CurveParams) <= kWordP * sizeof(Slot),
               "the curve overlays the axis and F slots only");
-static_assert(offsetof(Block, tool) == offsetof(Block, l) + 1, "L and T in a row");
 static_assert(offsetof(Block, n) - offsetof(Block, feed) ==
                   offsetof(State, line_number) - offsetof(State, feed),
               "feed, S and N are laid out as in State");
@@ -230,6 +235,8 @@ struct Work {
         motion::LineRequest req;
     };
 };
+static_assert(offsetof(Work, other) == offsetof(Work, b) + offsetof(Block, v) + sizeof(Block::v),
+              "Work::other is the slot past the block's last one");
 // In the motion side's scratch RAM (motion.h: it is ours from execute() until push_line()).
 static_assert(sizeof(void*) != 2 || sizeof(Work) == motion::kScratchBytes,
               "motion::kScratchBytes is the size of the work block on the AVR");
@@ -303,7 +310,7 @@ uint8_t import_command(Block& b, uint8_t m, const num::Decimal& d) {
     uint16_t gbit = static_cast<uint16_t>(1u << group);
     if (b.groups & gbit) return kModalGroupViolation;
     b.groups |= gbit;
-    if (group <= kGroupFlow) b.g[group] = value & 0x0F;
+    if (group <= kGroupNonModal) b.g[group] = value & 0x0F; // (never kBlockTool, kBlockL)
     return kOk;
 }
 
@@ -327,7 +334,7 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
         if (word == kWordN) {
             b.n = v;
         } else {
-            (&b.l)[word - kWordL] = static_cast<uint8_t>(v); // L, T: Block::l, tool
+            b.g[kBlockL + kWordL - word] = static_cast<uint8_t>(v); // L, T
         }
     }
     return kOk;
@@ -336,7 +343,10 @@ uint8_t import_value(Block& b, uint8_t word, const num::Decimal& d) {
 // The length word `word` of the block (its slot), in the units of the block, to um (or a feed to
 // mm/min x1000).
 __attribute__((noinline)) bool length(uint8_t word, int32_t& out) {
-    return num::length_to_milli(work().b.v[word].d, work().b.g[kGroupUnits] != 0, out);
+    static_assert(sizeof(bool) == 1, "a bool is a byte");
+    bool inches; // (the byte is 0 or 1 already: copied, not tested)
+    memcpy(&inches, &work().b.g[kGroupUnits], 1);
+    return num::length_to_milli(work().b.v[word].d, inches, out);
 }
 
 // um along axis a to steps, rounded (false when out of the int32 range).
@@ -344,15 +354,19 @@ __attribute__((noinline)) bool to_steps(int32_t um, uint8_t a, int32_t& steps) {
     return num::mul_div_round(um, g_settings.axis[a].steps_per_unit, 1000000u, steps);
 }
 
-// a + b, or a - b with `subtract`; an overflow sets Block::overflow (checked once per line:
-// error:33).
-__attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = false) {
+// a + b, a - b with kSub (or any other value but 0 and kKeep: combine2()'s ops), or a alone with
+// kKeep; an overflow sets Block::overflow (checked once
+// per line: error:33).
+enum AddOp : uint8_t { kAdd, kSub, kKeep = 4 };
+__attribute__((noinline)) int32_t add(int32_t a, int32_t b, uint8_t subtract = kAdd) {
 #if defined(__AVR__)
     // The chip's add/adc or sub/sbc chain, whose V flag is the signed overflow: the function
-    // takes 44 bytes and about 25 cycles, the portable test below 100 bytes and about 50. (The
+    // takes 48 bytes and about 25 cycles, the portable test below 100 bytes and about 50. (The
     // simavr checks run it: fw_test_*.)
     uint8_t v = 0;
-    asm("cpse %[s], __zero_reg__\n\t"
+    asm("sbrc %[s], 2\n\t"
+        "rjmp 3f\n\t"
+        "cpse %[s], __zero_reg__\n\t"
         "rjmp 1f\n\t"
         "add %A[a], %A[b]\n\t"
         "adc %B[a], %B[b]\n\t"
@@ -374,9 +388,10 @@ __attribute__((noinline)) int32_t add(int32_t a, int32_t b, bool subtract = fals
     return a;
 #else
     // Bit 31 of (a ^ r) & (b' ^ r) is the signed overflow of r = a + b'.
+    if (subtract == kKeep) return a;
     uint32_t ua = static_cast<uint32_t>(a), ub = static_cast<uint32_t>(b);
     if (subtract) ub = ~ub; // a - b = a + ~b + 1, and overflows as a + ~b would
-    uint32_t r = ua + ub + subtract;
+    uint32_t r = ua + ub + (subtract != kAdd);
     if (((ua ^ r) & (ub ^ r)) >> 31) work().b.overflow = 1;
     return static_cast<int32_t>(r);
 #endif
@@ -406,21 +421,25 @@ void set_end_modes(Modal& m) {
 }
 
 // Two points of the plane combined per coordinate: p - q, |p - q| (kMagnitudes, as uint32_t: 2^31
-// for INT32_MIN) or p + q (kSum). An overflow flags the block, as add() does.
-enum Op2 : uint8_t { kDifference, kMagnitudes, kSum };
+// for INT32_MIN) or p + q (kSum). An overflow flags the block, as add() does. (add() takes the op:
+// kSum adds, the others subtract.)
+enum Op2 : uint8_t { kSum = kAdd, kDifference = kSub, kMagnitudes = 2 };
 __attribute__((noinline)) void combine2(int32_t out[2], const int32_t p[2], const int32_t q[2],
                                         uint8_t op = kDifference) {
     for (uint8_t k = 0; k < 2; ++k) {
-        int32_t v = add(p[k], q[k], op != kSum);
+        int32_t v = add(p[k], q[k], op);
         out[k] = op == kMagnitudes ? static_cast<int32_t>(abs32(v)) : v;
     }
 }
 
 // |p - q| for two points of the plane, um.
-__attribute__((noinline)) Num dist_um(const int32_t p[2], const int32_t q[2]) {
+// (Into the caller's Num: returned, it would be copied through registers twice.) Returns its
+// floor.
+__attribute__((noinline)) uint32_t dist_um(const int32_t p[2], const int32_t q[2], Num& out) {
     uint32_t v[2];
     combine2(reinterpret_cast<int32_t*>(v), p, q, kMagnitudes);
-    return sum_squares(v, 2).sqrt();
+    out = sum_squares(v, 2);
+    return out.sqrt().u32();
 }
 
 // plane_axes() as a rotation: (u, v, w) = axes (k - plane) mod 3.
@@ -461,7 +480,11 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
         uint8_t a = ax[i & 1];
         uint32_t spu = g_settings.axis[a].steps_per_unit;
         if (spu < spu_min) spu_min = spu;
-        if (!to_steps(row[i], a, steps) || abs32(steps) > (1l << 22)) {
+        // (|steps| > 2^22 as one unsigned comparison: steps + 2^22 wraps above 2^23. A result
+        // out of the int32 range is saturated to +-(2^31 - 1): out of this one too.)
+        to_steps(row[i], a, steps);
+        if (static_cast<uint32_t>(static_cast<uint32_t>(steps) + (uint32_t(1) << 22)) >
+            (uint32_t(1) << 23)) {
             return false;
         }
     }
@@ -489,19 +512,39 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
             ellipse_direction(p[0], p[1], radii, cse[0], cse[1]);
             for (uint8_t k = 0; k < 2; ++k) {
                 uint32_t on = Num(abs32(cse[k]), -30).mul(radii[k]).u32(); // r |cs| (Q30)
-                // p - sign(cs) on, as sign(cs) (sign(cs) p - on): the same magnitude.
-                uint32_t d = static_cast<uint32_t>(p[k]);
-                if (cse[k] < 0) d = 0u - d;
-                d -= on;
+                // p - sign(cs) on, as |p| - on: the same magnitude (cs has the sign of p, or is
+                // 0: ellipse_direction() scales |p| and then gives it p's sign).
+                uint32_t d = abs32(p[k]) - on;
                 if (ellipse && abs32(static_cast<int32_t>(d)) > gap_um) return false;
             }
         }
         int64_t sweep = arc_sweep_q29(cs[0], cs[1], cs[2], cs[3], false, c.turns);
         // 0 <= sweep < 2^40 (Q29, 256 turns): radians in Q21 fit 32 bits. r sweep.
-        uint32_t q21 = static_cast<uint32_t>(sweep >> 8);
+        uint32_t q21;
+#if defined(__AVR__)
+        // Bytes 1 to 4 by moves: avr-gcc would call its 64-bit shift, which nothing else in the
+        // image needs (__ashrdi3 and __lshrdi3: 60 B).
+        asm("mov %A0, %B1\n\t"
+            "mov %B0, %C1\n\t"
+            "mov %C0, %D1\n\t"
+            "mov %D0, %r1+4"
+            : "=&r"(q21)
+            : "r"(sweep));
+#else
+        q21 = static_cast<uint32_t>(sweep >> 8);
+#endif
         reach.set(q21, -21).mul(radii[0] > radii[1] ? radii[0] : radii[1]);
     }
-    reach.add(Num(abs32(add(work().req.target_um[ax[2]], g_state.position[ax[2]], true))));
+    // The normal axis' travel: |target - position| as the first of a pair (the second, the next
+    // axis' or the words after the arrays, is not used).
+    static_assert(offsetof(State, position) + 4 * 4 <= sizeof(State) &&
+                      offsetof(motion::LineRequest, target_um) + 4 * 4 <=
+                          sizeof(motion::LineRequest),
+                  "the pair of the normal axis (2 at most) lies within the state and the request");
+    uint32_t w[2];
+    combine2(reinterpret_cast<int32_t*>(w), work().req.target_um + ax[2], g_state.position + ax[2],
+             kMagnitudes);
+    reach.add(Num(w[0]));
     return reach.u32() < (1ul << 23); // (floor(x) < 2^23 exactly when x < 2^23)
 }
 
@@ -509,9 +552,13 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
 // extensions' (ellipses, G5), and the geometry handed to the planner. Consumes its words.
 __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t axes,
                                               const State& st, CurveParams& c) {
-    uint8_t ax[3];
+    // The plane's axes, then (in place of the normal axis, which this function does not use)
+    // P's and Q's distances from I: the four words of the loop below as kWordI + ax[k].
+    uint8_t ax[4];
     const uint8_t plane = c.plane = b.g[kGroupPlane];
     axes_of(plane, ax);
+    ax[2] = static_cast<uint8_t>(kWordP - kWordI); // (wraps: kWordI + it is kWordP)
+    ax[3] = kWordQ - kWordI;
     // The normal of plane p is axis 2 - p (plane_axes), so the plane's axes are X Y Z but it.
     // (7 ^ (4 >> plane): 3, 5, 6, computed without a shift loop)
     const uint8_t in_plane = static_cast<uint8_t>(3 + 2 * plane - (plane >> 1));
@@ -529,7 +576,7 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     int32_t* const o = c.a_um;
     bool pq_not_positive = false; // an ellipse's semi-axes must be above 0
     for (uint8_t k = 0; k < 4; ++k) {
-        uint8_t word = static_cast<uint8_t>(k < 2 ? kWordI + ax[k] : k == 2 ? kWordP : kWordQ);
+        uint8_t word = static_cast<uint8_t>(kWordI + ax[k]);
         o[k] = 0;
         if ((b.words & bit(word)) && !length(word, o[k])) return kBadNumberFormat;
         if (k >= 2 && o[k] <= 0) pq_not_positive = true;
@@ -564,8 +611,9 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
             used = static_cast<WordMask>(used | bit(kWordR)); // I J K stay unused (GRBL: 36)
             int32_t rw;
             if (!length(kWordR, rw)) return kBadNumberFormat;
-            Num dn = dist_um(c.end_um, c.start_um); // |d|
-            if (dn.m == 0) return kInvalidTarget;   // start = end
+            Num dn;
+            dist_um(c.end_um, c.start_um, dn);    // |d|
+            if (dn.m == 0) return kInvalidTarget; // start = end
             // Centre on the perpendicular bisector: h = -sqrt(4 r^2 - d^2) / d, negated for
             // G3 and for a negative R (the longer arc).
             r = abs32(rw);
@@ -603,16 +651,15 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
     if (!ellipse && !bezier) {
         if (!(b.words & bit(kWordR))) {
             // The end must be on the circle: within 0.005 mm, or else within 0.5 mm and 0.1 %.
-            Num rn = dist_um(c.start_um, c.a_um);
-            r = rn.u32();
-            Num re = dist_um(c.end_um, c.a_um);
-            uint32_t x = re.u32(), delta = x > r ? x - r : r - x;
+            Num t;
+            r = dist_um(c.start_um, c.a_um, t);
+            uint32_t x = dist_um(c.end_um, c.a_um, t), delta = x > r ? x - r : r - x;
             // (delta > r / 1000 as delta * 1000 > r: the same for integers, delta <= 500.)
             if (delta > 5 && (delta > 500 || delta * 1000u > r)) return kInvalidTarget;
         }
         if (r == 0) return kInvalidTarget;
-        c.b_um[0] = static_cast<int32_t>(r);
-        c.b_um[1] = static_cast<int32_t>(r);
+        int32_t* radii = opaque(c.b_um); // (through a pointer: no absolute stores)
+        radii[0] = radii[1] = static_cast<int32_t>(r);
         if (b.words & bit(kWordP)) { // LinuxCNC: P turns, P1 the plain arc
             uint32_t turns;
             if (!num::to_uint(b.v[kWordP].d, 256u, turns)) return kCommandValueNotInteger;
@@ -629,25 +676,19 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
 
 uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     State& st = g_state;
-    outcome.then = Then::Nothing;
-    outcome.move = nullptr;
-    outcome.dwell_ms = 0;
+    static_assert(uint8_t(Then::Nothing) == 0, "an Outcome of zeros: nothing to do");
+    memset(&outcome, 0, sizeof(outcome));
 
     // ---- Stage 1: a block that starts from the current modes.
     Block& b = opaque(work().b);
-    static_assert(offsetof(State, tool) == sizeof(Modal) && sizeof(Modal) + 1 == 8,
-                  "modal and tool are two words");
-    b.g[kGroupNonModal] = kNoNonModal;
-    copy_words(&b.g[kGroupMotion], &st.modal, 2); // and the tool into the flow byte:
-    b.g[kGroupFlow] = kFlowRunning;
-    b.axis_command = kAxisNone;
-    b.overflow = 0;
-    b.l = 0xFF;
-    b.tool = st.tool;
-    b.groups = 0;
-    b.words = 0;
+    static_assert(offsetof(State, tool) == sizeof(Modal) && sizeof(Modal) + 1 == 8 &&
+                      kBlockTool == kGroupMotion + sizeof(Modal),
+                  "modal and tool are two words, in the state and in the block");
+    static_assert(kNoNonModal == 0 && kFlowRunning == 0 && kAxisNone == 0, "a header of zeros");
+    memset(&b, 0, offsetof(Block, v));            // and N
+    copy_words(&b.g[kGroupMotion], &st.modal, 2); // and the tool
+    b.g[kBlockL] = 0xFF;
     copy_words(&b.feed, &st.feed, 2); // and S
-    b.n = 0;
 
     // ---- Stage 2: import every word (letter + number), checking repeats, modal groups and
     // negative F N P S T.
@@ -655,7 +696,9 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         char letter = *line++;
         if (letter < 'A' || letter > 'Z') return kExpectedCommandLetter;
         uint8_t word = flash_read_byte(&kLetterInfo[letter - 'A']);
-        num::Decimal& d = word < kDecimalSlots ? b.v[word].d : work().other;
+        // Its slot, or Work::other for the other letters: the slot past the last one.
+        Slot* const slots = b.v; // (a pointer: indexing the array past its end is undefined)
+        num::Decimal& d = slots[word < kDecimalSlots ? word : kDecimalSlots].d;
         line = num::parse(line, d);
         if (line == nullptr) return kBadNumberFormat;
         uint8_t r = kUnsupportedCommand;
@@ -685,20 +728,22 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         return kNegativeValue;
     }
     // (N is 0 without the word, at most 10000000 when valid, else kNoLineNumber: its top bit.)
-    if (b.n >> 31) return kInvalidLineNumber;
+    // (Its top byte: both the chip and the host are little-endian.)
+    static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "N's top byte is its last");
+    if (reinterpret_cast<const uint8_t*>(&b.n)[3] & 0x80) return kInvalidLineNumber;
 
     // [3] Feed rate (G94 only): a new F in the units of the block, or the last one.
     if (b.words & bit(kWordF)) {
-        int32_t f;
-        if (!length(kWordF, f)) return kBadNumberFormat;
-        b.feed = static_cast<uint32_t>(f);
+        // (Straight into the block: a line rejected here never reaches stage 4.)
+        if (!length(kWordF, *reinterpret_cast<int32_t*>(&b.feed))) return kBadNumberFormat;
     }
 
-    // [10] Dwell: P seconds.
-    int32_t dwell_ms = 0;
+    // [10] Dwell: P seconds (the outcome's dwell_ms only counts with kDwell).
     if (non_modal == kDwellCmd) {
         if (!(b.words & bit(kWordP))) return kValueWordMissing;
-        if (!num::to_milli(b.v[kWordP].d, dwell_ms)) return kBadNumberFormat;
+        if (!num::to_milli(b.v[kWordP].d, *reinterpret_cast<int32_t*>(&outcome.dwell_ms))) {
+            return kBadNumberFormat;
+        }
         b.words = static_cast<WordMask>(b.words & ~bit(kWordP));
     }
 
@@ -706,46 +751,36 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     if (b.g[kGroupCoord] != 0) return kUnsupportedCoordSys;
 
     // [19] The axis words in um, then the non-modal commands that use them, or the target.
-    for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
-        // In place: length_to_milli() has read the number when it writes the um.
-        if ((m & 1) && !length(a, b.v[a].um)) return kBadNumberFormat;
-    }
-    // One pass over the axes computes either the new offsets (G10, G92) or the target of a
-    // move: an axis without a word keeps `keep`, an axis with a word gets its value, turned
-    // into a machine position by `op`.
-    enum Op : uint8_t {
-        kAsIs,         // G53 (machine coordinates), G10 L2 (the value is the new G54)
-        kPlusPosition, // G91
-        kPlusOffsets,  // G90: work position + G54 + G92
-        kFromPosition, // G92, G10 L20: position - the other offset - value
-    };
+    // One pass over the axes converts each word and computes either the new offsets (G10, G92)
+    // or the target of a move: an axis without a word keeps `keep`, an axis with a word gets its
+    // value v, turned into a machine position as (x op1 st[o1]) op2 y, st[o1] an array of State
+    // o1 bytes from the position (+ 4 kAxes: position_steps, + 8 kAxes: g54, + 12 kAxes: g92):
+    //   G53, G10 L2 (the value is the new G54): v
+    //   G91: v + position
+    //   G90: v + G54 + G92 (the work position)
+    //   G92, G10 L20: position - the other offset - v (x = position, y = v)
+    // The commands' own checks follow the pass, and its overflow them, in GRBL's order: a bad
+    // number first, then the command, then the target.
     bool offsets = non_modal == kSetCoordData || non_modal == kSetOffset;
     const int32_t* keep = st.position;
-    uint8_t other = 2 * kAxes; // the other offset for kFromPosition: g54 (below), or g92
-    uint8_t op = non_modal == kAbsoluteOverride ? kAsIs
-                 : b.g[kGroupDistance]          ? kPlusPosition
-                                                : kPlusOffsets;
+    uint8_t op1 = kKeep, op2 = kKeep, o1 = 0;
     if (offsets) {
         // G92: the current position becomes the given work position. G10 L20 P0|P1: the same
         // for G54; G10 L2: the given values are the new G54.
-        if (axes == 0) return kNoAxisWords;
         keep = st.g92;
-        op = kFromPosition;
+        op1 = op2 = kSub;
+        o1 = 2 * kAxes * 4; // G92: the other offset is G54
         if (non_modal == kSetCoordData) {
-            if (!(b.words & bit(kWordP)) || !(b.words & bit(kWordL))) return kValueWordMissing;
-            uint32_t p;
-            if (!num::to_uint(b.v[kWordP].d, 1u, p)) return kUnsupportedCoordSys;
-            if (b.l != 2 && b.l != 20) return kUnsupportedCommand;
-            if (b.l == 2) {
-                if (b.words & bit(kWordR)) return kUnsupportedCommand;
-                op = kAsIs;
-            }
-            b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
+            if (b.g[kBlockL] == 2) op1 = op2 = kKeep;
             keep = st.g54;
-            other = 3 * kAxes;
+            o1 = 3 * kAxes * 4; // and G92 for G10 L20
         }
-    } else if (non_modal == kAbsoluteOverride && motion > Motion::Linear) {
-        return kG53InvalidMotionMode;
+    } else if (non_modal != kAbsoluteOverride) {
+        op1 = kAdd;
+        if (!b.g[kGroupDistance]) {
+            op2 = kAdd;
+            o1 = 2 * kAxes * 4;
+        }
     }
     motion::LineRequest& req = work().req;
     static_assert(offsetof(State, position_steps) == offsetof(State, position) + 4 * kAxes &&
@@ -754,35 +789,58 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
                       offsetof(motion::LineRequest, target_um) ==
                           offsetof(motion::LineRequest, target_steps) + 4 * kAxes,
                   "the arrays of axes in a row");
+    // (Axis words always have a user here: [0] gave them to the motion mode, or G10 / G92 took
+    // them.)
     if (offsets || b.axis_command == kAxisMotion) {
         copy_words(req.target_um, keep, kAxes); // for G10 / G92: the new offsets
         copy_words(req.target_steps, st.position_steps, kAxes);
         for (uint8_t a = 0, m = axes; m != 0; ++a, m >>= 1) {
             if (!(m & 1)) continue;
+            // In place: length_to_milli() has read the number when it writes the um.
+            if (!length(a, b.v[a].um)) return kBadNumberFormat;
             // Axis a of the arrays in a row: st's position (+ kAxes: position_steps, + 2 kAxes:
             // g54, + 3 kAxes: g92) and req's target_steps (+ kAxes: target_um).
             const int32_t* const sa = st.position + a;
             int32_t* const ra = req.target_steps + a;
-            int32_t t = b.v[a].um;
-            if (op == kPlusPosition) {
-                t = add(t, sa[0]);
-            } else if (op == kPlusOffsets) {
-                t = add(add(t, sa[2 * kAxes]), sa[3 * kAxes]);
-            } else if (op == kFromPosition) {
-                t = add(add(sa[0], sa[other], true), t, true);
+            const int32_t *x = &b.v[a].um, *y = sa + 3 * kAxes;
+            if (op1 == kSub) { // G92, G10 L20
+                y = x;
+                x = sa;
             }
+            // (o1 in bytes: no shift an axis)
+            int32_t t = add(
+                add(*x,
+                    *reinterpret_cast<const int32_t*>(reinterpret_cast<const uint8_t*>(sa) + o1),
+                    op1),
+                *y, op2);
             ra[kAxes] = t;
             // Always from the absolute target: no rounding error accumulates. One move travels
             // at most kMaxLineTicks steps per axis (line.h).
             if (!offsets &&
+                // (|d| > max as one unsigned comparison: d + max wraps above 2 max.)
                 (!to_steps(t, a, ra[0]) ||
-                 abs32(static_cast<int32_t>(static_cast<uint32_t>(ra[0]) -
-                                            static_cast<uint32_t>(sa[kAxes]))) > kMaxLineTicks)) {
+                 static_cast<uint32_t>(ra[0]) - static_cast<uint32_t>(sa[kAxes]) + kMaxLineTicks >
+                     2u * kMaxLineTicks)) {
                 b.overflow = 1;
             }
         }
-        if (b.overflow) return kInvalidTarget;
     }
+    if (offsets) {
+        if (axes == 0) return kNoAxisWords;
+        if (non_modal == kSetCoordData) {
+            if (!(b.words & bit(kWordP)) || !(b.words & bit(kWordL))) return kValueWordMissing;
+            // (The value over the number's integer part, which it is when valid: no local.)
+            num::Decimal& p = b.v[kWordP].d;
+            if (!num::to_uint(p, 1u, p.ipart)) return kUnsupportedCoordSys;
+            uint8_t l = b.g[kBlockL];
+            if (l != 2 && l != 20) return kUnsupportedCommand;
+            if (l == 2 && (b.words & bit(kWordR))) return kUnsupportedCommand;
+            b.words = static_cast<WordMask>(b.words & ~(bit(kWordL) | bit(kWordP)));
+        }
+    } else if (non_modal == kAbsoluteOverride && motion > Motion::Linear) {
+        return kG53InvalidMotionMode;
+    }
+    if (b.overflow) return kInvalidTarget;
 
     // [20] Motion modes.
     bool curve = false;
@@ -811,10 +869,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     bool check = (flags & kCheckMode) != 0;
     bool moves = b.axis_command == kAxisMotion;
     if (!check) {
-        if (non_modal == kDwellCmd && !(flags & kDwellDone)) {
-            outcome.dwell_ms = static_cast<uint32_t>(dwell_ms);
-            return kDwell;
-        }
+        if (non_modal == kDwellCmd && !(flags & kDwellDone)) return kDwell;
         if ((offsets || non_modal == kResetOffset) && motion::state() != motion::State::Idle) {
             return kRetryWhenIdle;
         }
@@ -824,9 +879,8 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     }
 
     // ---- Stage 4: execute, in GRBL's order.
-    copy_words(&st.modal, &b.g[kGroupMotion], 2); // coord: 0, checked above; the tool:
-    st.tool = b.tool;
-    copy_words(&st.feed, &b.feed, 3); // and S, N
+    copy_words(&st.modal, &b.g[kGroupMotion], 2); // coord: 0, checked above; and the tool
+    copy_words(&st.feed, &b.feed, 3);             // and S, N
     if (offsets) {
         bool g10 = non_modal == kSetCoordData;
         copy_words(g10 ? st.g54 : st.g92, req.target_um, kAxes);
@@ -837,7 +891,7 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
         st.wco_changed = 1;
     }
     if (moves) {
-        req.feed = b.feed;
+        copy_words(&req.feed, &b.feed, 1); // (a call: 10 B less than the bytes' loads and stores)
         req.rapid = motion == Motion::Seek;
         req.curve = curve ? &b.curve : nullptr;
         if (!check) outcome.move = &req; // queued by the caller; the length was checked above
@@ -870,11 +924,24 @@ bool reset() {
     return ok;
 }
 
-void steps_to_um(const int32_t* steps, int32_t* um) {
+namespace {
+// Every axis between steps and um, in one loop for both ways: to um, um = steps x 10^6 / spu
+// (saturated on overflow); to steps, steps = um x spu / 10^6, written only when it fits.
+__attribute__((noinline)) void convert_axes(const int32_t* from, int32_t* to, bool to_um) {
     const AxisSettings* s = g_settings.axis;
-    for (uint8_t a = kAxes; a != 0; --a) {
-        num::mul_div_round(*steps++, 1000000u, (s++)->steps_per_unit, *um++);
+    for (uint8_t a = kAxes; a != 0; --a, ++to) {
+        uint32_t spu = (s++)->steps_per_unit;
+        int32_t v;
+        if (num::mul_div_round(*from++, to_um ? 1000000u : spu, to_um ? spu : 1000000u, v) ||
+            to_um) {
+            *to = v;
+        }
     }
+}
+} // namespace
+
+void steps_to_um(const int32_t* steps, int32_t* um) {
+    convert_axes(steps, um, true);
 }
 
 void sync_position() {
@@ -883,12 +950,7 @@ void sync_position() {
 }
 
 void settings_changed() {
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        int32_t steps;
-        if (to_steps(g_state.position[a], a, steps)) {
-            g_state.position_steps[a] = steps;
-        }
-    }
+    convert_axes(g_state.position, g_state.position_steps, false);
 }
 
 void work_offset(int32_t (&um)[kAxes]) {
@@ -907,7 +969,7 @@ void report_modes() {
     out::word('G', static_cast<uint8_t>(17u + m.plane));
     out::word('G', static_cast<uint8_t>(21u - m.inches));
     out::word('G', static_cast<uint8_t>(90u + m.incremental));
-    out::str(LL_PSTR(" G94"));
+    out::word('G', 94);
     out::word('M', m.spindle);
     out::word('M', m.coolant);
     out::word('T', g_state.tool);
