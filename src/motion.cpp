@@ -143,12 +143,10 @@ bool can_accept_curve() {
 bool push_line(const LineRequest& req) {
     Motion& m = mo();
     if (too_long(m.planner.last_target(), req.target_steps)) return false;
-    if (req.curve) {
-        if (!m.planner.shape_curve(req.target_um, *req.curve)) return false;
-        m.planner.add_curve(req.target_steps, req.target_um, req.feed, *req.curve);
-    } else {
-        m.planner.add(req.target_steps, req.target_um, req.feed, req.rapid);
-    }
+    if (req.curve && !m.planner.shape_curve(req.target_um, *req.curve)) return false;
+    uint32_t feed = req.feed;
+    if (req.rapid) feed = Planner::kRapid;
+    m.planner.add(req.target_steps, req.target_um, feed, req.curve);
     if (!m.planner.empty() && m.state == State::Idle) m.state = State::Cycle;
     poll();
     return true;

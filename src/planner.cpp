@@ -195,57 +195,84 @@ bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) 
     return moves;
 }
 
+// curve_shape() is one of the deepest stacks of the firmware (with stepping a curve: poll() ->
+// begin_curve()): shape_curve() (inline: curve_shape() runs straight under push_line()) keeps
+// its result in the free slot, and add() fills the slot with the curve once the shape is used.
+// A line and a curve share the block, the last target, the junction and the look-ahead passes;
+// only their limits and end directions differ.
 bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
-                  bool rapid) {
+                  const CurveParams* curve) {
     // Few locals, in scopes that do not overlap (they share their stack slots): the deepest
     // stack of the firmware runs through here.
     PlanBlock& b = *at(count_);
+    int32_t d[kAxes]; // steps, then the unit vector the move starts along (Q29)
+    const bool moves = open(b, target, d);
     uint8_t group;
-    {
-        int32_t d[kAxes];
-        MoveLimits lim;
-        if (!open(b, target, d)) {
+    uint8_t slot = 0; // 1 + the curve's slot
+    uint8_t n = 0;    // a curve's end tangent: 2 components, 3 when w is regulated
+    if (curve) {
+        const uint8_t plane = curve->plane;
+        const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
+        group = m_->group_of[plane == 2 ? 1 : 0];
+        const uint8_t in_plane = plane_mask(plane);
+        n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
+        slot = static_cast<uint8_t>(free_slot_index() + 1);
+        const CurveShape& shape = (slot == 2 ? curves_[1] : curves_[0]).shape;
+        // Speed: the requested feed, within the plane axes' rates (the tangent takes every
+        // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L),
+        // and the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in
+        // units/min x1000 sqrt(a r 1000) with a in units/min^2 and r in µm.
+        feed = min32(feed, min_over(*m_, kRate, in_plane));
+        Num t;
+        const int32_t dw_um = target_um[w] - last_um_[w];
+        if (dw_um != 0) {
+            feed = min32(feed, t.set(shape.len_q8, -8)
+                                   .mul(m_->settings->axis[w].max_rate)
+                                   .div(abs32(dw_um))
+                                   .u32());
+        }
+        const uint32_t accel = curve_accel(*m_, plane, d);
+        feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
+        b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
+        // Junctions from the tangents at both ends (w counts only when it is regulated).
+        place(d, shape.start_dir, plane, n);
+    } else {
+        if (!moves) {
             memcpy(last_um_, target_um, sizeof(last_um_));
             return false;
         }
         group = regulated_group(*m_, d);
-        move_limits(*m_, d, group, lim);
-        // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000. Num::mul() keeps the top 32 bits
-        // of the exact product, as num64(mul_wide()) would.
-        b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
-        feed = min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax);
-    }
-
-    // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
-    // first, then the unit vector in its place.
-    uint32_t xu[kAxes];
-    uint8_t neg = 0; // axes whose commanded travel is negative
-    uint8_t in_group = group;
-    for (uint8_t a = 0, bit = 1; a < kAxes;
-         ++a, bit = static_cast<uint8_t>(bit << 1), in_group >>= 1) {
-        int32_t du = target_um[a] - last_um_[a];
-        if (du < 0) neg = static_cast<uint8_t>(neg | bit);
-        xu[a] = (in_group & 1) ? abs32(du) : 0;
+        {
+            MoveLimits lim;
+            move_limits(*m_, d, group, lim);
+            // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000. Num::mul() keeps the top 32
+            // bits of the exact product, as num64(mul_wide()) would.
+            b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
+            feed = min32(feed, lim.vmax); // a rapid's 2^32 - 1 comes out as vmax
+        }
+        // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
+        // first, then the unit vector in d.
+        uint32_t xu[kAxes];
+        uint8_t neg = 0; // axes whose commanded travel is negative
+        uint8_t in_group = group;
+        for (uint8_t a = 0, bit = 1; a < kAxes;
+             ++a, bit = static_cast<uint8_t>(bit << 1), in_group >>= 1) {
+            int32_t du = target_um[a] - last_um_[a];
+            if (du < 0) neg = static_cast<uint8_t>(neg | bit);
+            xu[a] = (in_group & 1) ? abs32(du) : 0;
+        }
+        Num norm = sum_squares(xu, kAxes);
+        Num to_unit(1, 29);
+        to_unit.div(norm.sqrt());
+        for (uint8_t a = 0; a < kAxes; ++a, neg >>= 1) {
+            uint32_t u = to_unit.of(xu[a]);
+            if (u > (1ul << 29)) u = 1ul << 29;
+            d[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+        }
     }
     memcpy(last_um_, target_um, sizeof(last_um_));
-    Num n = sum_squares(xu, kAxes);
-    Num to_unit(1, 29);
-    to_unit.div(n.sqrt());
-    int32_t* unit = reinterpret_cast<int32_t*>(xu);
-    for (uint8_t a = 0; a < kAxes; ++a, neg >>= 1) {
-        uint32_t u = to_unit.of(xu[a]);
-        if (u > (1ul << 29)) u = 1ul << 29;
-        unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
-    }
-    finish_block(group, 0, feed, unit);
-    return true;
-}
-
-void Planner::finish_block(uint8_t group, uint8_t curve, uint32_t feed,
-                           const int32_t unit_in[kAxes]) {
-    PlanBlock& b = *at(count_);
     b.group = group & 0x3F;
-    b.curve = curve & 3;
+    b.curve = slot & 3;
     b.feed = at_least_1(feed);
     // From rest after no queued move or one of another group; else the junction, within
     // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
@@ -254,55 +281,23 @@ void Planner::finish_block(uint8_t group, uint8_t curve, uint32_t feed,
         const PlanBlock* prev = at(count_ - 1);
         if (static_cast<uint8_t>(prev->group) == group) {
             const uint32_t limit = speed2_of(min32(b.feed, prev->feed));
-            v2 = junction2(unit_in, limit);
+            v2 = junction2(d, limit);
         }
     }
     b.v_max_entry2 = v2;
     b.v_entry2 = 0;
     ++count_;
     recalculate();
-    memcpy(prev_unit_, unit_in, sizeof(prev_unit_)); // a curve then writes its end tangent
-}
-
-// curve_shape() is one of the deepest stacks of the firmware (with stepping a curve: poll() ->
-// begin_curve()): shape_curve() (inline: curve_shape() runs straight under push_line()) keeps
-// its result in the free slot, and add_curve() fills the slot with the curve once the shape is
-// used.
-void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
-                        const CurveParams& curve) {
-    const uint8_t plane = curve.plane;
-    const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
-    const uint8_t group = m_->group_of[plane == 2 ? 1 : 0];
-    const uint8_t in_plane = plane_mask(plane);
-    const uint8_t n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
-    const uint8_t slot = free_slot_index();
-    CurveSlot& s = slot ? curves_[1] : curves_[0];
-    const CurveShape& shape = s.shape;
-    curve_used_ = static_cast<uint8_t>(curve_used_ | (slot + 1));
-    PlanBlock& b = *at(count_);
-    int32_t d[kAxes];
-    open(b, target, d);
-    // Speed: the requested feed, within the plane axes' rates (the tangent takes every
-    // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L), and
-    // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
-    // sqrt(a r 1000) with a in units/min^2 and r in µm.
-    feed = min32(feed, min_over(*m_, kRate, in_plane));
-    Num t;
-    const int32_t dw_um = target_um[w] - last_um_[w];
-    memcpy(last_um_, target_um, sizeof(last_um_));
-    if (dw_um != 0) {
-        feed = min32(
-            feed,
-            t.set(shape.len_q8, -8).mul(m_->settings->axis[w].max_rate).div(abs32(dw_um)).u32());
+    if (curve) {
+        CurveSlot& s = slot == 2 ? curves_[1] : curves_[0];
+        curve_used_ = static_cast<uint8_t>(curve_used_ | slot);
+        // The direction it ends along, for the next junction.
+        place(prev_unit_, s.shape.end_dir, curve->plane, n);
+        s.queued.params = *curve; // over the shape (now used) but its length
+    } else {
+        memcpy(prev_unit_, d, sizeof(prev_unit_));
     }
-    const uint32_t accel = curve_accel(*m_, plane, d);
-    feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
-    b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
-    // Junctions from the tangents at both ends (w counts only when it is regulated).
-    place(d, shape.start_dir, plane, n);
-    finish_block(group, static_cast<uint8_t>(slot + 1), feed, d);
-    place(prev_unit_, shape.end_dir, plane, n);
-    s.queued.params = curve; // over the shape (now used) but its length
+    return true;
 }
 
 void Planner::recalculate() {

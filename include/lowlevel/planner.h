@@ -53,22 +53,23 @@ class Planner {
     bool empty() const { return count_ == 0; }
     uint8_t count() const { return count_; }
 
-    /// Queues the straight move from the last target to `target` (steps). `target_um` is the
-    /// same target as commanded (mm x1000): the junction angles come from it, so that rounding
-    /// targets to whole steps does not turn a smooth chain of short segments into a zigzag of
-    /// corners. The length (and so the feed) comes from the steps actually travelled. `feed` is
-    /// in units/min x1000 along the regulated path; `rapid` uses every axis' maximum rate.
-    /// Returns false when no axis moves (nothing queued). Preconditions: !full(), and no axis
-    /// travels more than kMaxLineTicks.
+    /// Queues the move from the last target to `target` (steps): straight when `curve` is null,
+    /// else along `curve` (seed part IV). `target_um` is the same target as commanded (mm x1000):
+    /// a line's junction angles come from it, so that rounding targets to whole steps does not
+    /// turn a smooth chain of short segments into a zigzag of corners. A line's length (and so
+    /// its feed) comes from the steps actually travelled. `feed` is in units/min x1000 along the
+    /// regulated path; 2^32 - 1 (kRapid) uses every axis' maximum rate. Returns false when a line
+    /// moves no axis (nothing queued). Preconditions: !full(), and no axis travels more than
+    /// kMaxLineTicks.
+    /// A curve is queued in two calls, so that the deepest computation of the firmware does not
+    /// stack on top of the second one's frame. shape_curve(): the curve's length, curvature limit
+    /// (v^2 <= a r) and end tangents (for the junctions) from curve_shape(), kept in the free
+    /// curve slot; false for a degenerate curve (then nothing is queued, and add() must not be
+    /// called). Then add() with the same `target_um` and `curve`. Precondition:
+    /// curve_slot_free() and !full().
     bool add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
-             bool rapid);
-    /// Queues a curve (seed part IV) from the last target to `target` along `curve`, in two
-    /// calls, so that the deepest computation of the firmware does not stack on top of the
-    /// second one's frame. shape_curve(): the curve's length, curvature limit (v^2 <= a r) and end
-    /// tangents (for the junctions) from curve_shape(), kept in the free curve slot; false for a
-    /// degenerate curve (then nothing is queued, and add_curve() must not be called). Then
-    /// add_curve() with the same `target_um` and `curve`. Precondition: curve_slot_free() and
-    /// !full().
+             const CurveParams* curve = nullptr);
+    static constexpr uint32_t kRapid = 0xFFFFFFFFul;
     bool shape_curve(const int32_t target_um[kAxes], const CurveParams& curve) {
         const uint8_t w = static_cast<uint8_t>(2 - curve.plane); // the normal axis
         const bool w_regulated = regulates_w(curve.plane);
@@ -77,8 +78,6 @@ class Planner {
         CurveSlot* const s = free_slot_index() ? curves_ + 1 : curves_;
         return curve_shape(curve, dw_um, w_regulated, s->shape);
     }
-    void add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
-                   const CurveParams& curve);
     /// A curve needs one of kCurveSlots slots besides its block.
     bool curve_slot_free() const { return curve_used_ != (1u << kCurveSlots) - 1; }
 
@@ -123,11 +122,6 @@ class Planner {
     /// Writes the move from the last target to `target` (steps) into `b` and `d`; `target`
     /// becomes the last target. Returns false when no axis moves.
     bool open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]);
-    /// Completes the block being queued (its deltas, curve and dv2 written): feed (at least 1),
-    /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes; then
-    /// prev_unit_ = `unit_in` (a curve overwrites it with the direction it ends along).
-    void finish_block(uint8_t group, uint8_t curve, uint32_t feed, const int32_t unit_in[kAxes]);
-
     /// A curve's slot: its length and parameters while its move is queued; before that, while
     /// the move is being queued, the curve's shape (shape_curve()). The length leads both (a
     /// common initial sequence): the shape's stays in place when the parameters replace the rest.
