@@ -58,7 +58,7 @@ __attribute__((noinline)) uint32_t min_over(const Machine& m, Limit which, uint8
 // The axes of a plane (plane_axes(): G17 X Y, G18 Z X, G19 Y Z), as a mask; its normal is axis
 // 2 - plane.
 uint8_t plane_mask(uint8_t plane) {
-    return static_cast<uint8_t>(7 ^ (4 >> plane));
+    return static_cast<uint8_t>(7 ^ normal_bit(plane));
 }
 
 // Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller

@@ -21,6 +21,12 @@ namespace ll {
 constexpr uint8_t kCurveSlots = 2;
 static_assert(kAxes <= 6 && kCurveSlots <= 3, "a block's group and curve share one byte");
 
+/// The bit of the normal axis of a curve's plane (axis 2 - plane): 4 >> plane without a shift
+/// loop.
+inline uint8_t normal_bit(uint8_t plane) {
+    return plane ? static_cast<uint8_t>(3 - plane) : 4;
+}
+
 struct PlanBlock {
     uint8_t delta[kAxes][3]; ///< steps per machine axis, signed 24-bit little-endian
     uint8_t group : 6;       ///< regulated axes (seed §3.1)
@@ -144,7 +150,7 @@ class Planner {
     /// curve's length).
     bool regulates_w(uint8_t plane) const {
         // The group of the plane's first machine axis (Y for G19, else X), and the normal axis.
-        return (m_->group_of[plane == 2 ? 1 : 0] & (4 >> plane)) != 0;
+        return (m_->group_of[plane == 2 ? 1 : 0] & normal_bit(plane)) != 0;
     }
 
     // The small fields first: within 64 bytes of `this`, the ATmega328P reaches them with one
