@@ -6,7 +6,7 @@
 namespace ll {
 namespace {
 
-uint32_t min32(uint32_t a, uint32_t b) {
+__attribute__((noinline)) uint32_t min32(uint32_t a, uint32_t b) {
     return a < b ? a : b;
 }
 
