@@ -173,8 +173,9 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     const AxisSettings* ax = m_->settings->axis;
     q.sqrt().mulc(k3_6, -16); // sqrt(q) 2^16 x 2^14 = |d| in Q29, x 3.6 (k3_6 2^-30)
     uint32_t acc = 0xFFFFFFFFul;
-    for (uint8_t a = 0; a < kAxes; ++a, ++ax) {
-        if (dc[a] != 0) acc = min32(acc, t.set(ax->accel).div(dc[a]).mul(q).u32());
+    const uint32_t* c = dc;
+    for (uint8_t mask = moving; mask != 0; mask >>= 1, ++ax, ++c) {
+        if (mask & 1) acc = min32(acc, t.set(ax->accel).div(*c).mul(q).u32());
     }
     r.mul(at_least_1(acc)).mul(m_->junction_dev_um);
     return min32(r.mulc(kMilli, -9).u32(), limit); // / 1000 (kMilli 2^-41), x 2^32
