@@ -23,6 +23,11 @@ __attribute__((noinline)) uint32_t at_least_1(uint32_t v) {
     return v;
 }
 
+// v = min(v, at_least_1(x)): a limit lowered in place.
+__attribute__((noinline)) void lower(uint32_t& v, uint32_t x) {
+    v = min32(v, at_least_1(x));
+}
+
 // Normalised constants for Num::mulc().
 constexpr uint32_t k3_6 = 0xE6666666ul; // 3.6 = k3_6 * 2^-30: units/s^2 x1000 -> units/min^2
 constexpr int8_t k3_6e = -30;
@@ -93,16 +98,13 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
     // limit_along() for the rate and the acceleration: the smallest over the moving axes of
     // limit x len / x[a], the rate and the acceleration from one quotient per axis.
     const AxisSettings* ax = m.settings->axis;
-    uint32_t vmax = 0xFFFFFFFFul, accel = 0xFFFFFFFFul; // nothing moves
+    out.vmax = out.accel = 0xFFFFFFFFul; // nothing moves
     for (uint8_t a = 0; a < kAxes; ++a, ++ax) {
         if (x[a] == 0) continue;
         Num r(out.len_q8);
-        vmax = min32(vmax, r.div(x[a]).of(ax->max_rate));
-        // units/s^2 x1000 -> units/min^2
-        accel = min32(accel, r.mulc(k3_6, k3_6e).of(ax->accel));
+        lower(out.vmax, r.div(x[a]).of(ax->max_rate));
+        lower(out.accel, r.mulc(k3_6, k3_6e).of(ax->accel)); // units/s^2 x1000 -> units/min^2
     }
-    out.vmax = at_least_1(vmax);
-    out.accel = at_least_1(accel);
 }
 
 void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
@@ -175,9 +177,9 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     uint32_t acc = 0xFFFFFFFFul;
     const uint32_t* c = dc;
     for (uint8_t mask = moving; mask != 0; mask >>= 1, ++ax, ++c) {
-        if (mask & 1) acc = min32(acc, t.set(ax->accel).div(*c).mul(q).u32());
+        if (mask & 1) lower(acc, t.set(ax->accel).div(*c).mul(q).u32());
     }
-    r.mul(at_least_1(acc)).mul(m_->junction_dev_um);
+    r.mul(acc).mul(m_->junction_dev_um);
     return min32(r.mulc(kMilli, -9).u32(), limit); // / 1000 (kMilli 2^-41), x 2^32
 }
 
