@@ -342,7 +342,7 @@ void Planner::recalculate() {
 }
 
 void Planner::spec_of_first(MoveSpec& s) const {
-    const PlanBlock* const b = ring_ + head_;
+    const PlanBlock* const b = const_cast<Planner*>(this)->at(0);
     for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(*b, a);
     // dv2 (the profile from the planner's own 2 a L), feed, v_entry2: one copy.
     static_assert(offsetof(MoveSpec, feed) == offsetof(MoveSpec, dv2) + 4 &&
