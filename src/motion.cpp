@@ -65,18 +65,6 @@ bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
     return false;
 }
 
-// The commanded position that matches a machine position in steps, mm x1000 (after an abort
-// the machine is between targets; the next move's direction is taken from here).
-void position_um(Motion& m, const int32_t steps[kAxes], int32_t um[kAxes]) {
-    const Num* k = m.machine.um_q8_per_step;
-    for (uint8_t a = kAxes; a != 0; --a) {
-        int32_t s = *steps++;
-        uint32_t v = (k++)->of(abs32(s)) >> 8;
-        if (s < 0) v = 0u - v;
-        *um++ = static_cast<int32_t>(v);
-    }
-}
-
 // Where the machine is while the planner is reset (abort(), settings_changed()), in the scratch
 // RAM: those run outside poll() and gcode::execute() (motion.h), and their frames shrink.
 struct Here {
@@ -85,12 +73,6 @@ struct Here {
 };
 inline Here& here_scratch() {
     return scratch<Here>();
-}
-
-__attribute__((noinline)) void reset_planner(Motion& m, const int32_t here[kAxes]) {
-    int32_t um[kAxes];
-    position_um(m, here, um);
-    m.planner.reset(here, um);
 }
 
 // Nothing queued for the step interrupt and nothing running.
@@ -117,7 +99,7 @@ void restart(Motion& m, const int32_t here[kAxes]) {
     g_exec.starved = 0;
     m.gen.abort();
     m.gen.set_position(here);
-    reset_planner(m, here);
+    m.planner.reset(here);
     m.begun = false;
     go_idle(m);
 }
@@ -125,6 +107,7 @@ void restart(Motion& m, const int32_t here[kAxes]) {
 } // namespace
 
 void init() {
+    mo().planner.configure(&mo().machine); // zero-filled until settings_changed()
     int32_t* zero = here_scratch().steps;
     memset(zero, 0, sizeof(Here::steps));
     restart(mo(), zero);
@@ -276,7 +259,6 @@ uint32_t current_feed() {
 void settings_changed() {
     Motion& m = mo();
     machine_build(m.machine, g_settings);
-    m.planner.configure(&m.machine);
     m.gen.configure(&m.machine.lengths, m.machine.min_period, m.machine.um_q8_per_step);
     hal::StepperConfig& cfg = here_scratch().cfg;
     cfg.pulse_cycles = static_cast<uint16_t>(g_settings.pulse_us * (kCpuHz / 1000000));
@@ -286,7 +268,7 @@ void settings_changed() {
     hal::stepper_configure(cfg);
     int32_t* here = here_scratch().steps;
     position(here);
-    reset_planner(m, here);
+    m.planner.reset(here);
     if (g_settings.idle_delay_ms == 255) enable(m, true);
 }
 

@@ -24,7 +24,7 @@ struct Fixture {
         ll::machine_build(m, s);
         p.configure(&m);
         int32_t zero[ll::kAxes] = {};
-        p.reset(zero, zero);
+        p.reset(zero);
     }
     void add_mm(double x, double y, double feed, double z = 0) {
         int32_t t[ll::kAxes] = {static_cast<int32_t>(std::lround(x * 80)),

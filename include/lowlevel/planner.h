@@ -51,9 +51,10 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
 class Planner {
   public:
     void configure(const Machine* m) { m_ = m; }
-    /// Empties the ring; the next move starts at `steps` (and `um`, the same position in
-    /// mm x1000) from rest.
-    void reset(const int32_t steps[kAxes], const int32_t um[kAxes]);
+    /// Empties the ring; the next move starts at `steps` from rest (and, for its direction, at
+    /// the commanded position in mm x1000 that matches it). Precondition: configure() was called
+    /// (with the settings then, or a zero-filled machine while `steps` is zero).
+    void reset(const int32_t steps[kAxes]);
 
     bool full() const { return count_ == kPlannerSize; }
     bool empty() const { return count_ == 0; }
