@@ -226,7 +226,8 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     const bool moves = open(b, target, d);
     uint8_t group;
     uint8_t slot = 0; // 1 + the curve's slot
-    uint8_t n = 0;    // a curve's end tangent: 2 components, 3 when w is regulated
+    CurveSlot* cs = nullptr;
+    uint8_t n = 0; // a curve's end tangent: 2 components, 3 when w is regulated
     if (curve) {
         const uint8_t plane = curve->plane;
         const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
@@ -234,7 +235,8 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         const uint8_t in_plane = plane_mask(plane);
         n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
         slot = static_cast<uint8_t>(free_slot_index() + 1);
-        const CurveShape& shape = (slot == 2 ? curves_[1] : curves_[0]).shape;
+        cs = slot == 2 ? curves_ + 1 : curves_;
+        const CurveShape& shape = cs->shape;
         // Speed: the requested feed, within the plane axes' rates (the tangent takes every
         // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L),
         // and the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in
@@ -306,7 +308,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     ++count_;
     recalculate();
     if (curve) {
-        CurveSlot& s = slot == 2 ? curves_[1] : curves_[0];
+        CurveSlot& s = *cs;
         curve_used_ = static_cast<uint8_t>(curve_used_ | slot);
         // The direction it ends along, for the next junction.
         place(prev_unit_, s.shape.end_dir, curve->plane, n);
