@@ -402,7 +402,6 @@ uint32_t Planner::exit2_of_first() const {
 }
 
 void Planner::discard_first() {
-    if (!count_) return;
     const PlanBlock& b = ring_[head_];
     // Slot s is bit s + 1 of curve_used_ with two slots, i.e. the block's curve field.
     curve_used_ = static_cast<uint8_t>(curve_used_ & ~b.curve);
@@ -412,7 +411,11 @@ void Planner::discard_first() {
 }
 
 void Planner::restart_first(uint32_t remaining, uint32_t total) {
-    if (!count_) return;
+#if defined(__AVR__)
+    // r12, r13 marked as used: the saved registers are then one run, which -mcall-prologues
+    // saves through its shared routines, not pushes and pops.
+    asm volatile("" ::: "r12", "r13");
+#endif
     PlanBlock* const b = ring_ + head_;
     if (total != 0) b->dv2 = Num(remaining).div(total).of(b->dv2);
     // Every move is replanned: as a move not begun yet, whose entry is held at 0 by its limit.

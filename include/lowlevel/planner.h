@@ -96,10 +96,12 @@ class Planner {
     uint32_t exit2_of_first() const;
     /// The step generator started the oldest move: its entry speed is now fixed.
     void begin_first() { first_begun_ = 1; }
+    /// Drops the oldest move. Precondition: !empty().
     void discard_first();
 
     /// After a feed hold stopped the oldest move with `remaining` of its `total` reference
-    /// ticks left: it restarts from rest, and every queued move is replanned.
+    /// ticks left: it restarts from rest, and every queued move is replanned. Precondition:
+    /// !empty() (motion calls it only for a begun move).
     void restart_first(uint32_t remaining, uint32_t total);
 
     const int32_t* last_target() const { return last_; }
