@@ -231,7 +231,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     if (curve) {
         const uint8_t plane = curve->plane;
         const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
-        group = m_->group_of[plane == 2 ? 1 : 0];
+        group = m_->group_of[plane >> 1];                  // see regulates_w()
         const uint8_t in_plane = plane_mask(plane);
         n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
         slot = static_cast<uint8_t>(free_slot_index() + 1);

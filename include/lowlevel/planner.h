@@ -152,8 +152,9 @@ class Planner {
     /// True when the normal axis of `plane` is regulated with the plane's axes (it counts in a
     /// curve's length).
     bool regulates_w(uint8_t plane) const {
-        // The group of the plane's first machine axis (Y for G19, else X), and the normal axis.
-        return (m_->group_of[plane == 2 ? 1 : 0] & normal_bit(plane)) != 0;
+        // The group of the plane's first machine axis (plane >> 1: Y for G19, else X), and the
+        // normal axis.
+        return (m_->group_of[plane >> 1] & normal_bit(plane)) != 0;
     }
 
     // The small fields first: within 64 bytes of `this`, the ATmega328P reaches them with one
