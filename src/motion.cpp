@@ -129,8 +129,9 @@ bool push_line(const LineRequest& req) {
     if (req.curve && !m.planner.shape_curve(req.target_um, *req.curve)) return false;
     uint32_t feed = req.feed;
     if (req.rapid) feed = Planner::kRapid;
-    m.planner.add(req.target_steps, req.target_um, feed, req.curve);
-    if (!m.planner.empty() && m.state == State::Idle) m.state = State::Cycle;
+    // (Idle means nothing queued: a move dropped for its zero length leaves it idle.)
+    if (m.planner.add(req.target_steps, req.target_um, feed, req.curve) && m.state == State::Idle)
+        m.state = State::Cycle;
     poll();
     return true;
 }
