@@ -108,25 +108,20 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
 }
 
 void Planner::reset(const int32_t steps[kAxes]) {
-#if defined(__AVR__)
-    // r8, r9 marked as used: with them the saved registers are one run (r4..r17, r28, r29), which
-    // -mcall-prologues saves through its shared routines, not 14 pushes and pops.
-    asm volatile("" ::: "r8", "r9");
-#endif
     head_ = 0;
     count_ = 0;
     curve_used_ = 0;
     first_begun_ = 0;
     memcpy(last_, steps, sizeof(last_));
     // The commanded position that matches the machine position, mm x1000 (after an abort the
-    // machine is between targets; the next move's direction is taken from here).
-    const Num* k = m_->um_q8_per_step;
-    int32_t* um = last_um_;
-    for (uint8_t a = kAxes; a != 0; --a) {
-        int32_t st = *steps++;
-        uint32_t v = (k++)->of(abs32(st)) >> 8;
-        if (st < 0) v = 0u - v;
-        *um++ = static_cast<int32_t>(v);
+    // machine is between targets; the next move's direction is taken from here): each axis'
+    // travel from zero (µm x 256), in place, then signed.
+    uint32_t* um = reinterpret_cast<uint32_t*>(last_um_);
+    travel(*m_, steps, 0, um);
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        uint32_t v = um[a] >> 8;
+        if (steps[a] < 0) v = 0u - v;
+        um[a] = v;
     }
 }
 
