@@ -17,7 +17,6 @@ namespace {
 // sets every field).
 struct Motion {
     State state;
-    bool begun;          ///< the planner's first move is in the step generator
     bool enabled;        ///< stepper drivers enabled
     uint16_t idle_since; ///< hal::millis() when motion last stopped, low 16 bits ($1 <= 254 ms)
     Machine machine;
@@ -35,7 +34,7 @@ inline Motion& mo() {
 // queue is full, a hold stops it or nothing is left.
 void produce(Motion& m) {
     for (;;) {
-        if (!m.begun) {
+        if (!m.planner.first_begun()) {
             if (m.planner.empty()) return;
             MoveSpec& spec = scratch<MoveSpec>(); // see motion.h
             m.planner.spec_of_first(spec);
@@ -44,13 +43,11 @@ void produce(Motion& m) {
                 continue;
             }
             m.planner.begin_first();
-            m.begun = true;
         }
         m.gen.set_exit(m.planner.exit2_of_first());
         m.gen.fill(g_runs);
         if (m.gen.active() || m.gen.stopped()) return; // queue full, or held
         m.planner.discard_first();
-        m.begun = false;
     }
 }
 
@@ -100,7 +97,6 @@ void restart(Motion& m, const int32_t here[kAxes]) {
     m.gen.abort();
     m.gen.set_position(here);
     m.planner.reset(here);
-    m.begun = false;
     go_idle(m);
 }
 
@@ -151,7 +147,8 @@ void poll() {
         return;
     }
     produce(m);
-    bool pending = m.begun || !m.planner.empty(); // a move is left to produce
+    // A move is left to produce (a begun move is still the planner's first).
+    bool pending = !m.planner.empty();
     if (!g_exec.running) {
         if (g_exec.starved && pending && !m.gen.stopped()) {
             g_starvations = static_cast<uint16_t>(g_starvations + 1); // dry mid-move
@@ -198,13 +195,13 @@ void cycle_start() {
 #endif
     Motion& m = mo();
     if (m.state != State::Held) return;
-    if (m.begun && m.gen.stopped()) {
+    if (m.planner.first_begun() && m.gen.stopped()) {
         m.planner.restart_first(m.gen.remaining(), m.gen.length());
         m.gen.resume(m.planner.exit2_of_first());
     } else {
         m.gen.resume(0);
     }
-    if (m.begun || !m.planner.empty()) {
+    if (!m.planner.empty()) {
         m.state = State::Cycle;
     } else {
         go_idle(m);

@@ -96,6 +96,8 @@ class Planner {
     uint32_t exit2_of_first() const;
     /// The step generator started the oldest move: its entry speed is now fixed.
     void begin_first() { first_begun_ = 1; }
+    /// True from begin_first() until the oldest move is discarded (or the ring reset).
+    bool first_begun() const { return first_begun_ != 0; }
     /// Drops the oldest move. Precondition: !empty().
     void discard_first();
 
