@@ -138,7 +138,9 @@ uint8_t blocks_free() {
 
 void poll() {
     Motion& m = mo();
-    if (m.state == State::Idle && m.planner.empty() && drained()) {
+    // (Idle: nothing queued in the planner. It goes idle only empty, and push_line() leaves
+    // Idle as it queues.)
+    if (m.state == State::Idle && drained()) {
         uint8_t delay = g_settings.idle_delay_ms; // read once: millis() is a call
         if (m.enabled && delay != 255 &&
             static_cast<uint16_t>(hal::millis() - m.idle_since) >= delay) {
