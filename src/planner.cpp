@@ -69,7 +69,8 @@ uint8_t plane_mask(uint8_t plane) {
 // Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
 // of the plane's two axes bounds it (and the normal axis' when a helix moves it: `delta`, steps).
 uint32_t curve_accel(const Machine& m, uint8_t plane, const int32_t delta[kAxes]) {
-    uint32_t acc = min_over(m, kAccel, delta[2 - plane] != 0 ? 7 : plane_mask(plane));
+    const int32_t* dw = delta + 2 - plane; // the normal axis' travel (pointer arithmetic: 8 B less)
+    uint32_t acc = min_over(m, kAccel, *dw != 0 ? 7 : plane_mask(plane));
     return at_least_1(Num(acc).mulc(k3_6, k3_6e).u32()); // units/s^2 x1000 -> units/min^2
 }
 
