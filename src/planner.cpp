@@ -164,8 +164,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     Num t, r;
     if (q.e < -32) {
         t.set(min_over(*m_, kAccel, moving)).mul(m_->junction_dev_um);
-        r.set(limit).mul(q);
-        r.e = static_cast<int8_t>(r.e + 10);
+        r.set(limit, 10).mul(q);
         if (t.cmp(r) >= 0) return limit;
     }
     // The exact formula (rare in chains of short segments).
