@@ -76,7 +76,9 @@ class Planner {
     /// curve_slot_free() and !full().
     bool add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
              const CurveParams* curve = nullptr);
+    /// add()'s `feed` for a rapid (G0): every axis' maximum rate bounds it.
     static constexpr uint32_t kRapid = 0xFFFFFFFFul;
+    /// add()'s first call for a curve (see add()).
     bool shape_curve(const int32_t target_um[kAxes], const CurveParams& curve) {
         const uint8_t w = static_cast<uint8_t>(2 - curve.plane); // the normal axis
         const bool w_regulated = regulates_w(curve.plane);
