@@ -231,14 +231,14 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
         slot = static_cast<uint8_t>(free_slot_index() + 1);
         cs = slot == 2 ? curves_ + 1 : curves_;
-        const CurveShape& shape = cs->shape;
+        const CurveShape& shape = cs->shaped.shape;
         // Speed: the requested feed, within the plane axes' rates (the tangent takes every
         // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L),
         // and the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in
         // units/min x1000 sqrt(a r 1000) with a in units/min^2 and r in µm.
         feed = min32(feed, min_over(*m_, kRate, in_plane));
         Num t;
-        const int32_t dw_um = target_um[w] - last_um_[w];
+        const int32_t dw_um = cs->shaped.dw_um;
         if (dw_um != 0) {
             feed = min32(feed, t.set(shape.len_q8, -8)
                                    .mul(m_->settings->axis[w].max_rate)
@@ -306,7 +306,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         CurveSlot& s = *cs;
         curve_used_ = static_cast<uint8_t>(curve_used_ | slot);
         // The direction it ends along, for the next junction.
-        place(prev_unit_, s.shape.end_dir, curve->plane, n);
+        place(prev_unit_, s.shaped.shape.end_dir, curve->plane, n);
         s.queued.params = *curve; // over the shape (now used) but its length
     } else {
         memcpy(prev_unit_, d, sizeof(prev_unit_));

@@ -82,10 +82,10 @@ class Planner {
     bool shape_curve(const int32_t target_um[kAxes], const CurveParams& curve) {
         const uint8_t w = static_cast<uint8_t>(2 - curve.plane); // the normal axis
         const bool w_regulated = regulates_w(curve.plane);
-        int32_t dw_um = 0;
-        if (w_regulated) dw_um = target_um[w] - last_um_[w];
         CurveSlot* const s = free_slot_index() ? curves_ + 1 : curves_;
-        return curve_shape(curve, dw_um, w_regulated, s->shape);
+        const int32_t dw_um = target_um[w] - last_um_[w];
+        s->shaped.dw_um = dw_um; // for add()
+        return curve_shape(curve, w_regulated ? dw_um : 0, w_regulated, s->shaped.shape);
     }
     /// A curve needs one of kCurveSlots slots besides its block.
     bool curve_slot_free() const { return curve_used_ != (1u << kCurveSlots) - 1; }
@@ -142,11 +142,15 @@ class Planner {
         uint32_t len_q8; ///< µm x 256
         CurveParams params;
     };
-    union CurveSlot {
+    struct ShapedCurve {
         CurveShape shape;
+        int32_t dw_um; ///< the normal axis' commanded travel (shape_curve() has it)
+    };
+    union CurveSlot {
+        ShapedCurve shaped;
         QueuedCurve queued;
     };
-    static_assert(offsetof(CurveShape, len_q8) == 0 && sizeof(CurveShape) <= sizeof(QueuedCurve),
+    static_assert(offsetof(CurveShape, len_q8) == 0 && sizeof(ShapedCurve) <= sizeof(QueuedCurve),
                   "the shape costs no RAM");
     /// The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
     uint8_t free_slot_index() const {
