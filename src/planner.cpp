@@ -222,13 +222,11 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     uint8_t group;
     uint8_t slot = 0; // 1 + the curve's slot
     CurveSlot* cs = nullptr;
-    uint8_t n = 0; // a curve's end tangent: 2 components, 3 when w is regulated
     if (curve) {
         const uint8_t plane = curve->plane;
         const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
         group = m_->group_of[plane >> 1];                  // see regulates_w()
         const uint8_t in_plane = plane_mask(plane);
-        n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
         slot = static_cast<uint8_t>(free_slot_index() + 1);
         cs = slot == 2 ? curves_ + 1 : curves_;
         const CurveShape& shape = cs->shaped.shape;
@@ -249,7 +247,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
         b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
         // Junctions from the tangents at both ends (w counts only when it is regulated).
-        place(d, shape.start_dir, plane, n);
+        place(d, shape.start_dir, plane, cs->shaped.dirs);
     } else {
         if (!moves) {
             memcpy(last_um_, target_um, sizeof(last_um_));
@@ -306,7 +304,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         CurveSlot& s = *cs;
         curve_used_ = static_cast<uint8_t>(curve_used_ | slot);
         // The direction it ends along, for the next junction.
-        place(prev_unit_, s.shaped.shape.end_dir, curve->plane, n);
+        place(prev_unit_, s.shaped.shape.end_dir, curve->plane, s.shaped.dirs);
         s.queued.params = *curve; // over the shape (now used) but its length
     } else {
         memcpy(prev_unit_, d, sizeof(prev_unit_));

@@ -85,6 +85,7 @@ class Planner {
         CurveSlot* const s = free_slot_index() ? curves_ + 1 : curves_;
         const int32_t dw_um = target_um[w] - last_um_[w];
         s->shaped.dw_um = dw_um; // for add()
+        s->shaped.dirs = static_cast<uint8_t>(2 + w_regulated);
         return curve_shape(curve, w_regulated ? dw_um : 0, w_regulated, s->shaped.shape);
     }
     /// A curve needs one of kCurveSlots slots besides its block.
@@ -145,6 +146,7 @@ class Planner {
     struct ShapedCurve {
         CurveShape shape;
         int32_t dw_um; ///< the normal axis' commanded travel (shape_curve() has it)
+        uint8_t dirs;  ///< components of the end tangents: 2, 3 when w is regulated
     };
     union CurveSlot {
         ShapedCurve shaped;
