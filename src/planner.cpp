@@ -279,7 +279,8 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         for (uint8_t a = 0; a < kAxes; ++a, neg >>= 1) {
             uint32_t u = to_unit.of(xu[a]);
             if (u > (1ul << 29)) u = 1ul << 29;
-            d[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
+            if (neg & 1) u = 0u - u;
+            d[a] = static_cast<int32_t>(u);
         }
     }
     memcpy(last_um_, target_um, sizeof(last_um_));
