@@ -142,6 +142,7 @@ __attribute__((noinline)) PlanBlock* Planner::at(uint8_t i) {
 // Writing 1 - sin as q / (1 + sin) keeps full precision on nearly straight paths, where a
 // chain of short segments spends its time; |w| keeps it near reversals.
 uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
+    const Machine& m = *m_; // loaded once
     uint32_t dc[kAxes];
     uint8_t moving = 0; // the axes of d
     for (uint8_t a = 0, bit = 1; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
@@ -163,7 +164,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // Nearly straight chains of short segments (the common case) stop here.
     Num t, r;
     if (q.e < -32) {
-        t.set(min_over(*m_, kAccel, moving)).mul(m_->junction_dev_um);
+        t.set(min_over(m, kAccel, moving)).mul(m.junction_dev_um);
         r.set(limit, 10).mul(q);
         if (t.cmp(r) >= 0) return limit;
     }
@@ -181,14 +182,14 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
     // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
     // 1000.
-    const AxisSettings* ax = m_->settings->axis;
+    const AxisSettings* ax = m.settings->axis;
     q.sqrt().mulc(k3_6, -16); // sqrt(q) 2^16 x 2^14 = |d| in Q29, x 3.6 (k3_6 2^-30)
     uint32_t acc = 0xFFFFFFFFul;
     const uint32_t* c = dc;
     for (uint8_t mask = moving; mask != 0; mask >>= 1, ++ax, ++c) {
         if (mask & 1) lower(acc, t.set(ax->accel).div(*c).mul(q).u32());
     }
-    r.mul(acc).mul(m_->junction_dev_um);
+    r.mul(acc).mul(m.junction_dev_um);
     return min32(r.mulc(kMilli, -9).u32(), limit); // / 1000 (kMilli 2^-41), x 2^32
 }
 
