@@ -215,6 +215,7 @@ bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) 
 // only their limits and end directions differ.
 bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                   const CurveParams* curve) {
+    const Machine& m = *m_; // loaded once
     // Few locals, in scopes that do not overlap (they share their stack slots): the deepest
     // stack of the firmware runs through here.
     PlanBlock& b = *at(count_);
@@ -226,7 +227,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     if (curve) {
         const uint8_t plane = curve->plane;
         const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
-        group = m_->group_of[plane >> 1];                  // see regulates_w()
+        group = m.group_of[plane >> 1];                    // see regulates_w()
         const uint8_t in_plane = plane_mask(plane);
         slot = static_cast<uint8_t>(free_slot_index() + 1);
         cs = slot == 2 ? curves_ + 1 : curves_;
@@ -235,16 +236,15 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L),
         // and the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in
         // units/min x1000 sqrt(a r 1000) with a in units/min^2 and r in µm.
-        feed = min32(feed, min_over(*m_, kRate, in_plane));
+        feed = min32(feed, min_over(m, kRate, in_plane));
         Num t;
         const int32_t dw_um = cs->shaped.dw_um;
         if (dw_um != 0) {
-            feed = min32(feed, t.set(shape.len_q8, -8)
-                                   .mul(m_->settings->axis[w].max_rate)
-                                   .div(abs32(dw_um))
-                                   .u32());
+            feed = min32(
+                feed,
+                t.set(shape.len_q8, -8).mul(m.settings->axis[w].max_rate).div(abs32(dw_um)).u32());
         }
-        const uint32_t accel = curve_accel(*m_, plane, d);
+        const uint32_t accel = curve_accel(m, plane, d);
         feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
         b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
         // Junctions from the tangents at both ends (w counts only when it is regulated).
@@ -254,10 +254,10 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
             memcpy(last_um_, target_um, sizeof(last_um_));
             return false;
         }
-        group = regulated_group(*m_, d);
+        group = regulated_group(m, d);
         {
             MoveLimits lim;
-            move_limits(*m_, d, group, lim);
+            move_limits(m, d, group, lim);
             // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000. Num::mul() keeps the top 32
             // bits of the exact product, as num64(mul_wide()) would.
             b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
