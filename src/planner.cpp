@@ -119,10 +119,10 @@ void Planner::reset(const int32_t steps[kAxes]) {
     // travel from zero (µm x 256), in place, then signed.
     uint32_t* um = reinterpret_cast<uint32_t*>(last_um_);
     travel(*m_, steps, 0, um);
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        uint32_t v = um[a] >> 8;
-        if (steps[a] < 0) v = 0u - v;
-        um[a] = v;
+    for (uint8_t a = kAxes; a != 0; --a, ++um) {
+        uint32_t v = *um >> 8;
+        if (*steps++ < 0) v = 0u - v;
+        *um = v;
     }
 }
 
