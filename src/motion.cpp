@@ -17,7 +17,6 @@ namespace {
 // sets every field).
 struct Motion {
     State state;
-    bool begun;          ///< the planner's first move is in the step generator
     bool enabled;        ///< stepper drivers enabled
     uint16_t idle_since; ///< hal::millis() when motion last stopped, low 16 bits ($1 <= 254 ms)
     Machine machine;
@@ -35,7 +34,7 @@ inline Motion& mo() {
 // queue is full, a hold stops it or nothing is left.
 void produce(Motion& m) {
     for (;;) {
-        if (!m.begun) {
+        if (!m.planner.first_begun()) {
             if (m.planner.empty()) return;
             MoveSpec& spec = scratch<MoveSpec>(); // see motion.h
             m.planner.spec_of_first(spec);
@@ -44,13 +43,11 @@ void produce(Motion& m) {
                 continue;
             }
             m.planner.begin_first();
-            m.begun = true;
         }
         m.gen.set_exit(m.planner.exit2_of_first());
         m.gen.fill(g_runs);
         if (m.gen.active() || m.gen.stopped()) return; // queue full, or held
         m.planner.discard_first();
-        m.begun = false;
     }
 }
 
@@ -65,18 +62,6 @@ bool too_long(const int32_t from[kAxes], const int32_t to[kAxes]) {
     return false;
 }
 
-// The commanded position that matches a machine position in steps, mm x1000 (after an abort
-// the machine is between targets; the next move's direction is taken from here).
-void position_um(Motion& m, const int32_t steps[kAxes], int32_t um[kAxes]) {
-    const Num* k = m.machine.um_q8_per_step;
-    for (uint8_t a = kAxes; a != 0; --a) {
-        int32_t s = *steps++;
-        uint32_t v = (k++)->of(abs32(s)) >> 8;
-        if (s < 0) v = 0u - v;
-        *um++ = static_cast<int32_t>(v);
-    }
-}
-
 // Where the machine is while the planner is reset (abort(), settings_changed()), in the scratch
 // RAM: those run outside poll() and gcode::execute() (motion.h), and their frames shrink.
 struct Here {
@@ -85,12 +70,6 @@ struct Here {
 };
 inline Here& here_scratch() {
     return scratch<Here>();
-}
-
-__attribute__((noinline)) void reset_planner(Motion& m, const int32_t here[kAxes]) {
-    int32_t um[kAxes];
-    position_um(m, here, um);
-    m.planner.reset(here, um);
 }
 
 // Nothing queued for the step interrupt and nothing running.
@@ -117,14 +96,14 @@ void restart(Motion& m, const int32_t here[kAxes]) {
     g_exec.starved = 0;
     m.gen.abort();
     m.gen.set_position(here);
-    reset_planner(m, here);
-    m.begun = false;
+    m.planner.reset(here);
     go_idle(m);
 }
 
 } // namespace
 
 void init() {
+    mo().planner.configure(&mo().machine); // zero-filled until settings_changed()
     int32_t* zero = here_scratch().steps;
     memset(zero, 0, sizeof(Here::steps));
     restart(mo(), zero);
@@ -143,13 +122,12 @@ bool can_accept_curve() {
 bool push_line(const LineRequest& req) {
     Motion& m = mo();
     if (too_long(m.planner.last_target(), req.target_steps)) return false;
-    if (req.curve) {
-        if (!m.planner.shape_curve(req.target_um, *req.curve)) return false;
-        m.planner.add_curve(req.target_steps, req.target_um, req.feed, *req.curve);
-    } else {
-        m.planner.add(req.target_steps, req.target_um, req.feed, req.rapid);
-    }
-    if (!m.planner.empty() && m.state == State::Idle) m.state = State::Cycle;
+    if (req.curve && !m.planner.shape_curve(req.target_um, *req.curve)) return false;
+    uint32_t feed = req.feed;
+    if (req.rapid) feed = Planner::kRapid;
+    // (Idle means nothing queued: a move dropped for its zero length leaves it idle.)
+    if (m.planner.add(req.target_steps, req.target_um, feed, req.curve) && m.state == State::Idle)
+        m.state = State::Cycle;
     poll();
     return true;
 }
@@ -160,7 +138,9 @@ uint8_t blocks_free() {
 
 void poll() {
     Motion& m = mo();
-    if (m.state == State::Idle && m.planner.empty() && drained()) {
+    // (Idle: nothing queued in the planner. It goes idle only empty, and push_line() leaves
+    // Idle as it queues.)
+    if (m.state == State::Idle && drained()) {
         uint8_t delay = g_settings.idle_delay_ms; // read once: millis() is a call
         if (m.enabled && delay != 255 &&
             static_cast<uint16_t>(hal::millis() - m.idle_since) >= delay) {
@@ -169,7 +149,8 @@ void poll() {
         return;
     }
     produce(m);
-    bool pending = m.begun || !m.planner.empty(); // a move is left to produce
+    // A move is left to produce (a begun move is still the planner's first).
+    bool pending = !m.planner.empty();
     if (!g_exec.running) {
         if (g_exec.starved && pending && !m.gen.stopped()) {
             g_starvations = static_cast<uint16_t>(g_starvations + 1); // dry mid-move
@@ -216,13 +197,13 @@ void cycle_start() {
 #endif
     Motion& m = mo();
     if (m.state != State::Held) return;
-    if (m.begun && m.gen.stopped()) {
+    if (m.planner.first_begun() && m.gen.stopped()) {
         m.planner.restart_first(m.gen.remaining(), m.gen.length());
         m.gen.resume(m.planner.exit2_of_first());
     } else {
         m.gen.resume(0);
     }
-    if (m.begun || !m.planner.empty()) {
+    if (!m.planner.empty()) {
         m.state = State::Cycle;
     } else {
         go_idle(m);
@@ -278,7 +259,6 @@ uint32_t current_feed() {
 void settings_changed() {
     Motion& m = mo();
     machine_build(m.machine, g_settings);
-    m.planner.configure(&m.machine);
     m.gen.configure(&m.machine.lengths, m.machine.min_period, m.machine.um_q8_per_step);
     hal::StepperConfig& cfg = here_scratch().cfg;
     cfg.pulse_cycles = static_cast<uint16_t>(g_settings.pulse_us * (kCpuHz / 1000000));
@@ -288,7 +268,7 @@ void settings_changed() {
     hal::stepper_configure(cfg);
     int32_t* here = here_scratch().steps;
     position(here);
-    reset_planner(m, here);
+    m.planner.reset(here);
     if (g_settings.idle_delay_ms == 255) enable(m, true);
 }
 

@@ -6,7 +6,7 @@
 namespace ll {
 namespace {
 
-uint32_t min32(uint32_t a, uint32_t b) {
+__attribute__((noinline)) uint32_t min32(uint32_t a, uint32_t b) {
     return a < b ? a : b;
 }
 
@@ -23,36 +23,16 @@ __attribute__((noinline)) uint32_t at_least_1(uint32_t v) {
     return v;
 }
 
+// v = min(v, at_least_1(x)): a limit lowered in place.
+__attribute__((noinline)) void lower(uint32_t& v, uint32_t x) {
+    v = min32(v, at_least_1(x));
+}
+
 // Normalised constants for Num::mulc().
 constexpr uint32_t k3_6 = 0xE6666666ul; // 3.6 = k3_6 * 2^-30: units/s^2 x1000 -> units/min^2
 constexpr int8_t k3_6e = -30;
 constexpr uint32_t kMilli = 0x83126E97ul; // 1/1000 = kMilli * 2^-41 (1/128000: 2^-48)
 constexpr uint32_t kMicro = 0x8637BD05ul; // 1e-6 = kMicro * 2^-51 (5e-7: 2^-52)
-
-// n1 / d1 < n2 / d2, exactly (64-bit products).
-bool ratio_less(uint32_t n1, uint32_t d1, uint32_t n2, uint32_t d2) {
-    if (n1 == n2) return d1 > d2;
-    uint32_t l1, h1 = mul_wide(n1, d2, l1);
-    uint32_t l2, h2 = mul_wide(n2, d1, l2);
-    return h1 != h2 ? h1 < h2 : l1 < l2;
-}
-
-// The axis with comp[a] > 0 whose lim[a] / comp[a] is the smallest (the first one on a tie),
-// kAxes when every comp[a] is 0.
-uint8_t tightest(const AxisSettings* ax, Limit which, const uint32_t comp[kAxes]) {
-    uint8_t best = kAxes;
-    uint32_t best_lim = 0, best_comp = 0;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        const uint32_t c = comp[a], lim = ax[a].*which;
-        if (c == 0) continue;
-        if (best == kAxes || ratio_less(lim, c, best_lim, best_comp)) {
-            best = a;
-            best_lim = lim;
-            best_comp = c;
-        }
-    }
-    return best;
-}
 
 // x <= 5e-7 (GRBL's junction thresholds): 5e-7 = kMicro 2^-52. A zero (exponent 0) is not
 // caught here: junction2()'s q has its exponent lowered by 60 first (a zero q is tiny), and a
@@ -83,13 +63,14 @@ __attribute__((noinline)) uint32_t min_over(const Machine& m, Limit which, uint8
 // The axes of a plane (plane_axes(): G17 X Y, G18 Z X, G19 Y Z), as a mask; its normal is axis
 // 2 - plane.
 uint8_t plane_mask(uint8_t plane) {
-    return static_cast<uint8_t>(7 ^ (4 >> plane));
+    return static_cast<uint8_t>(7 ^ normal_bit(plane));
 }
 
 // Acceleration along a curve, units/min^2: its tangent turns through the plane, so the smaller
 // of the plane's two axes bounds it (and the normal axis' when a helix moves it: `delta`, steps).
 uint32_t curve_accel(const Machine& m, uint8_t plane, const int32_t delta[kAxes]) {
-    uint32_t acc = min_over(m, kAccel, delta[2 - plane] != 0 ? 7 : plane_mask(plane));
+    const int32_t* dw = delta + 2 - plane; // the normal axis' travel (pointer arithmetic: 8 B less)
+    uint32_t acc = min_over(m, kAccel, *dw != 0 ? 7 : plane_mask(plane));
     return at_least_1(Num(acc).mulc(k3_6, k3_6e).u32()); // units/s^2 x1000 -> units/min^2
 }
 
@@ -115,34 +96,34 @@ void place(int32_t out[kAxes], const int32_t dir[3], uint8_t plane, uint8_t n) {
 void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out) {
     uint32_t x[kAxes];
     out.len_q8 = travel(m, delta, group, x);
-    // limit_along() for the rate, then the acceleration, sharing len / x[a] when one axis bounds
-    // both (the common case): one division.
+    // limit_along() for the rate and the acceleration: the smallest over the moving axes of
+    // limit x len / x[a], the rate and the acceleration from one quotient per axis.
     const AxisSettings* ax = m.settings->axis;
-    Num r;
-    uint8_t prev = kAxes;
-    static_assert(offsetof(MoveLimits, accel) == offsetof(MoveLimits, vmax) + 4, "in order");
-    uint32_t* o = &out.vmax; // then out.accel
-    for (uint8_t k = 0; k < 2; ++k, ++o) {
-        const Limit which = k ? kAccel : kRate;
-        const uint8_t a = tightest(ax, which, x);
-        uint32_t v = 0xFFFFFFFFul; // nothing moves
-        if (a != kAxes) {
-            if (a != prev) r.set(out.len_q8).div(x[a]);
-            prev = a;
-            if (k) r.mulc(k3_6, k3_6e); // units/s^2 x1000 -> units/min^2
-            v = at_least_1(r.of(ax[a].*which));
-        }
-        *o = v;
+    out.vmax = out.accel = 0xFFFFFFFFul; // nothing moves
+    for (uint8_t a = 0; a < kAxes; ++a, ++ax) {
+        if (x[a] == 0) continue;
+        Num r(out.len_q8);
+        lower(out.vmax, r.div(x[a]).of(ax->max_rate));
+        lower(out.accel, r.mulc(k3_6, k3_6e).of(ax->accel)); // units/s^2 x1000 -> units/min^2
     }
 }
 
-void Planner::reset(const int32_t steps[kAxes], const int32_t um[kAxes]) {
+void Planner::reset(const int32_t steps[kAxes]) {
     head_ = 0;
     count_ = 0;
     curve_used_ = 0;
     first_begun_ = 0;
     memcpy(last_, steps, sizeof(last_));
-    memcpy(last_um_, um, sizeof(last_um_));
+    // The commanded position that matches the machine position, mm x1000 (after an abort the
+    // machine is between targets; the next move's direction is taken from here): each axis'
+    // travel from zero (µm x 256), in place, then signed.
+    uint32_t* um = reinterpret_cast<uint32_t*>(last_um_);
+    travel(*m_, steps, 0, um);
+    for (uint8_t a = kAxes; a != 0; --a, ++um) {
+        uint32_t v = *um >> 8;
+        if (*steps++ < 0) v = 0u - v;
+        *um = v;
+    }
 }
 
 uint32_t Planner::nominal2(const PlanBlock& b) {
@@ -161,6 +142,7 @@ __attribute__((noinline)) PlanBlock* Planner::at(uint8_t i) {
 // Writing 1 - sin as q / (1 + sin) keeps full precision on nearly straight paths, where a
 // chain of short segments spends its time; |w| keeps it near reversals.
 uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
+    const Machine& m = *m_; // loaded once
     uint32_t dc[kAxes];
     uint8_t moving = 0; // the axes of d
     for (uint8_t a = 0, bit = 1; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
@@ -182,9 +164,8 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // Nearly straight chains of short segments (the common case) stop here.
     Num t, r;
     if (q.e < -32) {
-        t.set(min_over(*m_, kAccel, moving)).mul(m_->junction_dev_um);
-        r.set(limit).mul(q);
-        r.e = static_cast<int8_t>(r.e + 10);
+        t.set(min_over(m, kAccel, moving)).mul(m.junction_dev_um);
+        r.set(limit, 10).mul(q);
         if (t.cmp(r) >= 0) return limit;
     }
     // The exact formula (rare in chains of short segments).
@@ -201,10 +182,14 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
     // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
     // 1000.
-    const AxisSettings* ax = m_->settings->axis;
-    uint8_t a = tightest(ax, kAccel, dc);
+    const AxisSettings* ax = m.settings->axis;
     q.sqrt().mulc(k3_6, -16); // sqrt(q) 2^16 x 2^14 = |d| in Q29, x 3.6 (k3_6 2^-30)
-    r.mul(at_least_1(t.set(ax[a].accel).div(dc[a]).mul(q).u32())).mul(m_->junction_dev_um);
+    uint32_t acc = 0xFFFFFFFFul;
+    const uint32_t* c = dc;
+    for (uint8_t mask = moving; mask != 0; mask >>= 1, ++ax, ++c) {
+        if (mask & 1) lower(acc, t.set(ax->accel).div(*c).mul(q).u32());
+    }
+    r.mul(acc).mul(m.junction_dev_um);
     return min32(r.mulc(kMilli, -9).u32(), limit); // / 1000 (kMilli 2^-41), x 2^32
 }
 
@@ -223,57 +208,85 @@ bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) 
     return moves;
 }
 
+// curve_shape() is one of the deepest stacks of the firmware (with stepping a curve: poll() ->
+// begin_curve()): shape_curve() (inline: curve_shape() runs straight under push_line()) keeps
+// its result in the free slot, and add() fills the slot with the curve once the shape is used.
+// A line and a curve share the block, the last target, the junction and the look-ahead passes;
+// only their limits and end directions differ.
 bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
-                  bool rapid) {
+                  const CurveParams* curve) {
+    const Machine& m = *m_; // loaded once
     // Few locals, in scopes that do not overlap (they share their stack slots): the deepest
     // stack of the firmware runs through here.
     PlanBlock& b = *at(count_);
+    int32_t d[kAxes]; // steps, then the unit vector the move starts along (Q29)
+    const bool moves = open(b, target, d);
     uint8_t group;
-    {
-        int32_t d[kAxes];
-        MoveLimits lim;
-        if (!open(b, target, d)) {
+    uint8_t slot = 0; // 1 + the curve's slot
+    CurveSlot* cs = nullptr;
+    if (curve) {
+        const uint8_t plane = curve->plane;
+        const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
+        group = m.group_of[plane >> 1];                    // see regulates_w()
+        const uint8_t in_plane = plane_mask(plane);
+        slot = static_cast<uint8_t>(free_slot_index() + 1);
+        cs = slot == 2 ? curves_ + 1 : curves_;
+        const CurveShape& shape = cs->shaped.shape;
+        // Speed: the requested feed, within the plane axes' rates (the tangent takes every
+        // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L),
+        // and the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in
+        // units/min x1000 sqrt(a r 1000) with a in units/min^2 and r in µm.
+        feed = min32(feed, min_over(m, kRate, in_plane));
+        Num t;
+        const int32_t dw_um = cs->shaped.dw_um;
+        if (dw_um != 0) {
+            feed = min32(
+                feed,
+                t.set(shape.len_q8, -8).mul(m.settings->axis[w].max_rate).div(abs32(dw_um)).u32());
+        }
+        const uint32_t accel = curve_accel(m, plane, d);
+        feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
+        b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
+        // Junctions from the tangents at both ends (w counts only when it is regulated).
+        place(d, shape.start_dir, plane, cs->shaped.dirs);
+    } else {
+        if (!moves) {
             memcpy(last_um_, target_um, sizeof(last_um_));
             return false;
         }
-        group = regulated_group(*m_, d);
-        move_limits(*m_, d, group, lim);
-        // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000. Num::mul() keeps the top 32 bits
-        // of the exact product, as num64(mul_wide()) would.
-        b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
-        feed = min32(rapid ? 0xFFFFFFFFul : feed, lim.vmax);
-    }
-
-    // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
-    // first, then the unit vector in its place.
-    uint32_t xu[kAxes];
-    uint8_t neg = 0; // axes whose commanded travel is negative
-    uint8_t in_group = group;
-    for (uint8_t a = 0, bit = 1; a < kAxes;
-         ++a, bit = static_cast<uint8_t>(bit << 1), in_group >>= 1) {
-        int32_t du = target_um[a] - last_um_[a];
-        if (du < 0) neg = static_cast<uint8_t>(neg | bit);
-        xu[a] = (in_group & 1) ? abs32(du) : 0;
+        group = regulated_group(m, d);
+        {
+            MoveLimits lim;
+            move_limits(m, d, group, lim);
+            // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000. Num::mul() keeps the top 32
+            // bits of the exact product, as num64(mul_wide()) would.
+            b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
+            feed = min32(feed, lim.vmax); // a rapid's 2^32 - 1 comes out as vmax
+        }
+        // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
+        // first, then the unit vector in d.
+        uint32_t xu[kAxes];
+        uint8_t neg = 0; // axes whose commanded travel is negative
+        uint8_t in_group = group;
+        for (uint8_t a = 0, bit = 1; a < kAxes;
+             ++a, bit = static_cast<uint8_t>(bit << 1), in_group >>= 1) {
+            int32_t du = target_um[a] - last_um_[a];
+            if (du < 0) neg = static_cast<uint8_t>(neg | bit);
+            xu[a] = (in_group & 1) ? abs32(du) : 0;
+        }
+        Num norm = sum_squares(xu, kAxes);
+        Num to_unit(1, 29);
+        to_unit.div(norm.sqrt());
+        for (uint8_t a = 0; a < kAxes; ++a, neg >>= 1) {
+            uint32_t u = to_unit.of(xu[a]);
+            if (u > (1ul << 29)) u = 1ul << 29;
+            if (neg & 1) u = 0u - u;
+            d[a] = static_cast<int32_t>(u);
+        }
     }
     memcpy(last_um_, target_um, sizeof(last_um_));
-    Num n = sum_squares(xu, kAxes);
-    Num to_unit(1, 29);
-    to_unit.div(n.sqrt());
-    int32_t* unit = reinterpret_cast<int32_t*>(xu);
-    for (uint8_t a = 0; a < kAxes; ++a, neg >>= 1) {
-        uint32_t u = to_unit.of(xu[a]);
-        if (u > (1ul << 29)) u = 1ul << 29;
-        unit[a] = (neg & 1) ? -static_cast<int32_t>(u) : static_cast<int32_t>(u);
-    }
-    finish_block(group, 0, feed, unit);
-    return true;
-}
-
-void Planner::finish_block(uint8_t group, uint8_t curve, uint32_t feed,
-                           const int32_t unit_in[kAxes]) {
-    PlanBlock& b = *at(count_);
     b.group = group & 0x3F;
-    b.curve = curve & 3;
+    b.curve = slot & 3;
     b.feed = at_least_1(feed);
     // From rest after no queued move or one of another group; else the junction, within
     // min(nominal2(b), nominal2(previous)) = nominal2 of the smaller feed: one product.
@@ -282,55 +295,23 @@ void Planner::finish_block(uint8_t group, uint8_t curve, uint32_t feed,
         const PlanBlock* prev = at(count_ - 1);
         if (static_cast<uint8_t>(prev->group) == group) {
             const uint32_t limit = speed2_of(min32(b.feed, prev->feed));
-            v2 = junction2(unit_in, limit);
+            v2 = junction2(d, limit);
         }
     }
     b.v_max_entry2 = v2;
     b.v_entry2 = 0;
     ++count_;
     recalculate();
-    memcpy(prev_unit_, unit_in, sizeof(prev_unit_)); // a curve then writes its end tangent
-}
-
-// curve_shape() is one of the deepest stacks of the firmware (with stepping a curve: poll() ->
-// begin_curve()): shape_curve() (inline: curve_shape() runs straight under push_line()) keeps
-// its result in the free slot, and add_curve() fills the slot with the curve once the shape is
-// used.
-void Planner::add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
-                        const CurveParams& curve) {
-    const uint8_t plane = curve.plane;
-    const uint8_t w = static_cast<uint8_t>(2 - plane); // the normal axis
-    const uint8_t group = m_->group_of[plane == 2 ? 1 : 0];
-    const uint8_t in_plane = plane_mask(plane);
-    const uint8_t n = group & (7 ^ in_plane) ? 3 : 2; // 3: w is regulated (regulates_w())
-    const uint8_t slot = free_slot_index();
-    CurveSlot& s = slot ? curves_[1] : curves_[0];
-    const CurveShape& shape = s.shape;
-    curve_used_ = static_cast<uint8_t>(curve_used_ | (slot + 1));
-    PlanBlock& b = *at(count_);
-    int32_t d[kAxes];
-    open(b, target, d);
-    // Speed: the requested feed, within the plane axes' rates (the tangent takes every
-    // direction of the plane), the normal axis' rate along a helix (it moves at v dw / L), and
-    // the curvature: v^2 / r <= a at the tightest point (DESIGN.md, part IV), in units/min x1000
-    // sqrt(a r 1000) with a in units/min^2 and r in µm.
-    feed = min32(feed, min_over(*m_, kRate, in_plane));
-    Num t;
-    const int32_t dw_um = target_um[w] - last_um_[w];
-    memcpy(last_um_, target_um, sizeof(last_um_));
-    if (dw_um != 0) {
-        feed = min32(
-            feed,
-            t.set(shape.len_q8, -8).mul(m_->settings->axis[w].max_rate).div(abs32(dw_um)).u32());
+    if (curve) {
+        CurveSlot& s = *cs;
+        curve_used_ = static_cast<uint8_t>(curve_used_ | slot);
+        // The direction it ends along, for the next junction.
+        place(prev_unit_, s.shaped.shape.end_dir, curve->plane, s.shaped.dirs);
+        s.queued.params = *curve; // over the shape (now used) but its length
+    } else {
+        memcpy(prev_unit_, d, sizeof(prev_unit_));
     }
-    const uint32_t accel = curve_accel(*m_, plane, d);
-    feed = min32(feed, t.set(accel).mul(shape.min_radius_um).mul(1000).sqrt().u32());
-    b.dv2 = t.set(shape.len_q8).mul(accel).div(128000).u32();
-    // Junctions from the tangents at both ends (w counts only when it is regulated).
-    place(d, shape.start_dir, plane, n);
-    finish_block(group, static_cast<uint8_t>(slot + 1), feed, d);
-    place(prev_unit_, shape.end_dir, plane, n);
-    s.queued.params = curve; // over the shape (now used) but its length
+    return true;
 }
 
 void Planner::recalculate() {
@@ -372,7 +353,7 @@ void Planner::recalculate() {
 }
 
 void Planner::spec_of_first(MoveSpec& s) const {
-    const PlanBlock* const b = ring_ + head_;
+    const PlanBlock* const b = const_cast<Planner*>(this)->at(0);
     for (uint8_t a = 0; a < kAxes; ++a) s.delta[a] = delta(*b, a);
     // dv2 (the profile from the planner's own 2 a L), feed, v_entry2: one copy.
     static_assert(offsetof(MoveSpec, feed) == offsetof(MoveSpec, dv2) + 4 &&
@@ -416,7 +397,6 @@ uint32_t Planner::exit2_of_first() const {
 }
 
 void Planner::discard_first() {
-    if (!count_) return;
     const PlanBlock& b = ring_[head_];
     // Slot s is bit s + 1 of curve_used_ with two slots, i.e. the block's curve field.
     curve_used_ = static_cast<uint8_t>(curve_used_ & ~b.curve);
@@ -426,7 +406,11 @@ void Planner::discard_first() {
 }
 
 void Planner::restart_first(uint32_t remaining, uint32_t total) {
-    if (!count_) return;
+#if defined(__AVR__)
+    // r12, r13 marked as used: the saved registers are then one run, which -mcall-prologues
+    // saves through its shared routines, not pushes and pops.
+    asm volatile("" ::: "r12", "r13");
+#endif
     PlanBlock* const b = ring_ + head_;
     if (total != 0) b->dv2 = Num(remaining).div(total).of(b->dv2);
     // Every move is replanned: as a move not begun yet, whose entry is held at 0 by its limit.

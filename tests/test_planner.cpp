@@ -24,7 +24,7 @@ struct Fixture {
         ll::machine_build(m, s);
         p.configure(&m);
         int32_t zero[ll::kAxes] = {};
-        p.reset(zero, zero);
+        p.reset(zero);
     }
     void add_mm(double x, double y, double feed, double z = 0) {
         int32_t t[ll::kAxes] = {static_cast<int32_t>(std::lround(x * 80)),
@@ -33,7 +33,7 @@ struct Fixture {
         int32_t um[ll::kAxes] = {static_cast<int32_t>(std::lround(x * 1000)),
                                  static_cast<int32_t>(std::lround(y * 1000)),
                                  static_cast<int32_t>(std::lround(z * 1000)), 0};
-        p.add(t, um, static_cast<uint32_t>(feed * 1000), false);
+        p.add(t, um, static_cast<uint32_t>(feed * 1000));
     }
     const ll::PlanBlock& block(uint8_t i) { return p.block(i); }
     ll::MoveLimits limits(uint8_t i) {

@@ -21,6 +21,12 @@ namespace ll {
 constexpr uint8_t kCurveSlots = 2;
 static_assert(kAxes <= 6 && kCurveSlots <= 3, "a block's group and curve share one byte");
 
+/// The bit of the normal axis of a curve's plane (axis 2 - plane): 4 >> plane without a shift
+/// loop.
+inline uint8_t normal_bit(uint8_t plane) {
+    return plane ? static_cast<uint8_t>(3 - plane) : 4;
+}
+
 struct PlanBlock {
     uint8_t delta[kAxes][3]; ///< steps per machine axis, signed 24-bit little-endian
     uint8_t group : 6;       ///< regulated axes (seed §3.1)
@@ -37,7 +43,7 @@ struct PlanBlock {
 struct MoveLimits {
     uint32_t len_q8; ///< µm x 256
     uint32_t vmax;   ///< units/min x1000
-    uint32_t accel;  ///< units/min^2 (after vmax: move_limits() writes them in this order)
+    uint32_t accel;  ///< units/min^2
 };
 void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out);
 
@@ -45,40 +51,43 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
 class Planner {
   public:
     void configure(const Machine* m) { m_ = m; }
-    /// Empties the ring; the next move starts at `steps` (and `um`, the same position in
-    /// mm x1000) from rest.
-    void reset(const int32_t steps[kAxes], const int32_t um[kAxes]);
+    /// Empties the ring; the next move starts at `steps` from rest (and, for its direction, at
+    /// the commanded position in mm x1000 that matches it). Precondition: configure() was called
+    /// (with the settings then, or a zero-filled machine while `steps` is zero).
+    void reset(const int32_t steps[kAxes]);
 
     bool full() const { return count_ == kPlannerSize; }
     bool empty() const { return count_ == 0; }
     uint8_t count() const { return count_; }
 
-    /// Queues the straight move from the last target to `target` (steps). `target_um` is the
-    /// same target as commanded (mm x1000): the junction angles come from it, so that rounding
-    /// targets to whole steps does not turn a smooth chain of short segments into a zigzag of
-    /// corners. The length (and so the feed) comes from the steps actually travelled. `feed` is
-    /// in units/min x1000 along the regulated path; `rapid` uses every axis' maximum rate.
-    /// Returns false when no axis moves (nothing queued). Preconditions: !full(), and no axis
-    /// travels more than kMaxLineTicks.
+    /// Queues the move from the last target to `target` (steps): straight when `curve` is null,
+    /// else along `curve` (seed part IV). `target_um` is the same target as commanded (mm x1000):
+    /// a line's junction angles come from it, so that rounding targets to whole steps does not
+    /// turn a smooth chain of short segments into a zigzag of corners. A line's length (and so
+    /// its feed) comes from the steps actually travelled. `feed` is in units/min x1000 along the
+    /// regulated path; 2^32 - 1 (kRapid) uses every axis' maximum rate. Returns false when a line
+    /// moves no axis (nothing queued). Preconditions: !full(), and no axis travels more than
+    /// kMaxLineTicks.
+    /// A curve is queued in two calls, so that the deepest computation of the firmware does not
+    /// stack on top of the second one's frame. shape_curve(): the curve's length, curvature limit
+    /// (v^2 <= a r) and end tangents (for the junctions) from curve_shape(), kept in the free
+    /// curve slot; false for a degenerate curve (then nothing is queued, and add() must not be
+    /// called). Then add() with the same `target_um` and `curve`. Precondition:
+    /// curve_slot_free() and !full().
     bool add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
-             bool rapid);
-    /// Queues a curve (seed part IV) from the last target to `target` along `curve`, in two
-    /// calls, so that the deepest computation of the firmware does not stack on top of the
-    /// second one's frame. shape_curve(): the curve's length, curvature limit (v^2 <= a r) and end
-    /// tangents (for the junctions) from curve_shape(), kept in the free curve slot; false for a
-    /// degenerate curve (then nothing is queued, and add_curve() must not be called). Then
-    /// add_curve() with the same `target_um` and `curve`. Precondition: curve_slot_free() and
-    /// !full().
+             const CurveParams* curve = nullptr);
+    /// add()'s `feed` for a rapid (G0): every axis' maximum rate bounds it.
+    static constexpr uint32_t kRapid = 0xFFFFFFFFul;
+    /// add()'s first call for a curve (see add()).
     bool shape_curve(const int32_t target_um[kAxes], const CurveParams& curve) {
         const uint8_t w = static_cast<uint8_t>(2 - curve.plane); // the normal axis
         const bool w_regulated = regulates_w(curve.plane);
-        int32_t dw_um = 0;
-        if (w_regulated) dw_um = target_um[w] - last_um_[w];
         CurveSlot* const s = free_slot_index() ? curves_ + 1 : curves_;
-        return curve_shape(curve, dw_um, w_regulated, s->shape);
+        const int32_t dw_um = target_um[w] - last_um_[w];
+        s->shaped.dw_um = dw_um; // for add()
+        s->shaped.dirs = static_cast<uint8_t>(2 + w_regulated);
+        return curve_shape(curve, w_regulated ? dw_um : 0, w_regulated, s->shaped.shape);
     }
-    void add_curve(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
-                   const CurveParams& curve);
     /// A curve needs one of kCurveSlots slots besides its block.
     bool curve_slot_free() const { return curve_used_ != (1u << kCurveSlots) - 1; }
 
@@ -90,10 +99,14 @@ class Planner {
     uint32_t exit2_of_first() const;
     /// The step generator started the oldest move: its entry speed is now fixed.
     void begin_first() { first_begun_ = 1; }
+    /// True from begin_first() until the oldest move is discarded (or the ring reset).
+    bool first_begun() const { return first_begun_ != 0; }
+    /// Drops the oldest move. Precondition: !empty().
     void discard_first();
 
     /// After a feed hold stopped the oldest move with `remaining` of its `total` reference
-    /// ticks left: it restarts from rest, and every queued move is replanned.
+    /// ticks left: it restarts from rest, and every queued move is replanned. Precondition:
+    /// !empty() (motion calls it only for a begun move).
     void restart_first(uint32_t remaining, uint32_t total);
 
     const int32_t* last_target() const { return last_; }
@@ -123,11 +136,6 @@ class Planner {
     /// Writes the move from the last target to `target` (steps) into `b` and `d`; `target`
     /// becomes the last target. Returns false when no axis moves.
     bool open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]);
-    /// Completes the block being queued (its deltas, curve and dv2 written): feed (at least 1),
-    /// junction limit from the unit vector `unit_in` it starts along, look-ahead passes; then
-    /// prev_unit_ = `unit_in` (a curve overwrites it with the direction it ends along).
-    void finish_block(uint8_t group, uint8_t curve, uint32_t feed, const int32_t unit_in[kAxes]);
-
     /// A curve's slot: its length and parameters while its move is queued; before that, while
     /// the move is being queued, the curve's shape (shape_curve()). The length leads both (a
     /// common initial sequence): the shape's stays in place when the parameters replace the rest.
@@ -135,11 +143,16 @@ class Planner {
         uint32_t len_q8; ///< µm x 256
         CurveParams params;
     };
-    union CurveSlot {
+    struct ShapedCurve {
         CurveShape shape;
+        int32_t dw_um; ///< the normal axis' commanded travel (shape_curve() has it)
+        uint8_t dirs;  ///< components of the end tangents: 2, 3 when w is regulated
+    };
+    union CurveSlot {
+        ShapedCurve shaped;
         QueuedCurve queued;
     };
-    static_assert(offsetof(CurveShape, len_q8) == 0 && sizeof(CurveShape) <= sizeof(QueuedCurve),
+    static_assert(offsetof(CurveShape, len_q8) == 0 && sizeof(ShapedCurve) <= sizeof(QueuedCurve),
                   "the shape costs no RAM");
     /// The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
     uint8_t free_slot_index() const {
@@ -149,8 +162,9 @@ class Planner {
     /// True when the normal axis of `plane` is regulated with the plane's axes (it counts in a
     /// curve's length).
     bool regulates_w(uint8_t plane) const {
-        // The group of the plane's first machine axis (Y for G19, else X), and the normal axis.
-        return (m_->group_of[plane == 2 ? 1 : 0] & (4 >> plane)) != 0;
+        // The group of the plane's first machine axis (plane >> 1: Y for G19, else X), and the
+        // normal axis.
+        return (m_->group_of[plane >> 1] & normal_bit(plane)) != 0;
     }
 
     // The small fields first: within 64 bytes of `this`, the ATmega328P reaches them with one
