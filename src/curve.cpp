@@ -4,6 +4,7 @@
 #include "lowlevel/pgm.h"
 #include "lowlevel/scratch.h"
 
+#include <stddef.h>
 #include <string.h>
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the walker reads the high word of int64");
@@ -278,19 +279,6 @@ __attribute__((noinline)) void unit_vector(Num* q, uint8_t n, uint8_t neg, uint8
     }
 }
 
-// |sweep| in (0, 2 pi] from the angle a0 to the angle a1 (radians x 2^29, in (-pi, pi]),
-// clockwise or not: a closed arc is a full turn. The difference is taken modulo 2^32, where the
-// result (below 2^32) is exact.
-uint32_t sweep_q29(int32_t a0, int32_t a1, bool clockwise) {
-    if (clockwise) {
-        int32_t t = a0;
-        a0 = a1;
-        a1 = t;
-    }
-    uint32_t d = static_cast<uint32_t>(a1) - static_cast<uint32_t>(a0);
-    return a1 > a0 ? d : d + kTurnQ29;
-}
-
 // q = (|v0|, |v1|, third); returns the signs of v0 and v1 (bits 0 and 1).
 __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& third, Num q[3]) {
     q[2] = third;
@@ -311,28 +299,42 @@ __attribute__((noinline)) void direction_of(int32_t v[2], const uint32_t radii[2
     unit_vector(q, 2, neg, 30, v);
 }
 
-// ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30. (Not
-// inlined twice into arc_directions().)
-__attribute__((noinline)) void direction(const int32_t p[2], const int32_t centre[2],
-                                         const uint32_t radii[2], int32_t out[2]) {
-    out[0] = p[0] - centre[0];
-    out[1] = p[1] - centre[1];
-    direction_of(out, radii);
+// |sweep| in (0, 2 pi] from the direction dir[0] to dir[1] (Q30), clockwise or not (radians x
+// 2^29): a closed arc is a full turn. The difference of the angles (in (-pi, pi]) is taken
+// modulo 2^32, where the result (below 2^32) is exact; clockwise, from dir[1] to dir[0].
+__attribute__((noinline)) uint32_t sweep_of(const int32_t dir[2][2], bool clockwise) {
+    const int32_t* from = dir[clockwise];
+    const int32_t* to = dir[!clockwise];
+    const int32_t a0 = atan2_q29(from[1], from[0]);
+    const int32_t a1 = atan2_q29(to[1], to[0]);
+    const uint32_t d = static_cast<uint32_t>(a1) - static_cast<uint32_t>(a0);
+    return a1 > a0 ? d : d + kTurnQ29;
 }
 
-// Directions (cos t, sin t) of an arc's start and end seen from its centre in the ellipse's
-// scale (Q30), and its sweep without the extra turns (radians x 2^29, never 0); 0 for a null
-// radius.
-__attribute__((noinline)) uint32_t arc_directions(const int32_t start[2], const int32_t end[2],
-                                                  const int32_t centre[2], const uint32_t radii[2],
-                                                  bool clockwise, int32_t dir[2][2]) {
+// Directions (cos t, sin t) of an arc's start and end (`ends`: the two points in a row, as in
+// CurveParams and CurveWalker::Ends) seen from its centre in the ellipse's scale (Q30), and
+// |sweep| without the extra turns (radians x 2^29, never 0); 0 for a null radius.
+__attribute__((noinline)) uint32_t arc_directions(const int32_t ends[2][2], const int32_t centre[2],
+                                                  const uint32_t radii[2], bool clockwise,
+                                                  int32_t dir[2][2]) {
     if (radii[0] == 0 || radii[1] == 0) return 0;
-    direction(start, centre, radii, dir[0]);
-    direction(end, centre, radii, dir[1]);
-    // The signed sweep's low word (its magnitude is below 2^32).
-    const uint32_t sweep = static_cast<uint32_t>(
-        arc_sweep_q29(dir[0][0], dir[0][1], dir[1][0], dir[1][1], clockwise, 0));
-    return clockwise ? 0u - sweep : sweep;
+    for (uint8_t e = 0; e < 2; ++e) {
+        for (uint8_t k = 0; k < 2; ++k) dir[e][k] = ends[e][k] - centre[k];
+        direction_of(dir[e], radii);
+    }
+    return sweep_of(dir, clockwise);
+}
+
+// The start and end points of a curve as a row of two (consecutive fields, pinned here).
+inline const int32_t (*ends_of(const CurveParams& c))[2] {
+    static_assert(offsetof(CurveParams, end_um) == offsetof(CurveParams, start_um) + 8,
+                  "start and end in a row");
+    return &c.start_um;
+}
+inline const int32_t (*ends_of(const CurveWalker::Ends& e))[2] {
+    static_assert(offsetof(CurveWalker::Ends, end_q8) == offsetof(CurveWalker::Ends, start_q8) + 8,
+                  "start and end in a row");
+    return &e.start_q8;
 }
 
 // One sample of a cubic by forward differencing: f += d1, d1 += d2, d2 += d3 (v = f, d1, d2, d3).
@@ -472,7 +474,8 @@ void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], i
 
 int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clockwise,
                       uint8_t turns) {
-    int64_t sweep = sweep_q29(atan2_q29(s0, c0), atan2_q29(s1, c1), clockwise);
+    const int32_t dir[2][2] = {{c0, s0}, {c1, s1}};
+    int64_t sweep = sweep_of(dir, clockwise);
     while (turns--) sweep = add_turn(sweep);
     return clockwise ? -sweep : sweep;
 }
@@ -493,8 +496,7 @@ void CurveWalker::start_piece(Piece& g) {
     // The cubic from prev_q8_ (p0) to p3 whose control points are p0 + arm0 / 3 and
     // p3 - arm3 / 3, ticks x 256: relative to p0, c1 t + c2 t^2 + c3 t^3 with c1 = arm0,
     // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0 (in place of arm0, p3 and arm3).
-    uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
-    for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
+    memset(fd_, 0, sizeof(fd_));
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
     for (uint8_t a = 0; a < 3; ++a) {
         // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
@@ -550,7 +552,7 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     memcpy(a_.radii, radii_q8, sizeof(a_.radii));
     // Directions of the start and end points (their projections on the curve), and the sweep
     // with the extra turns, radians x 2^20 (below 2^31 for 255 turns).
-    uint32_t mag = arc_directions(e.start_q8, e.end_q8, a_.centre, a_.radii, clockwise, a_.dir);
+    uint32_t mag = arc_directions(ends_of(e), a_.centre, a_.radii, clockwise, a_.dir);
     if (mag == 0) return false; // a null radius
     mag = (mag >> 9) + turns * (kTurnQ29 >> 9);
     // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees) and kMaxPieceTicks long (sweep x
@@ -973,7 +975,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
         k.clockwise = cp.clockwise != 0;
         // The sweep in (0, 2 pi], and with the extra full turns, radians.
-        span = arc_directions(cp.start_um, cp.end_um, cp.a_um, r, k.clockwise, k.e.dir);
+        span = arc_directions(ends_of(cp), cp.a_um, r, k.clockwise, k.e.dir);
         if (span == 0) return false; // a null radius
         widest = kWidestArcQ29;
         turns = cp.turns;
