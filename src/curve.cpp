@@ -279,6 +279,11 @@ __attribute__((noinline)) void unit_vector(Num* q, uint8_t n, uint8_t neg, uint8
     }
 }
 
+// The larger of an ellipse's semi-axes.
+__attribute__((noinline)) uint32_t larger(const uint32_t r[2]) {
+    return r[0] > r[1] ? r[0] : r[1];
+}
+
 // q = (|v0|, |v1|, third); returns the signs of v0 and v1 (bits 0 and 1).
 __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& third, Num q[3]) {
     q[2] = third;
@@ -557,7 +562,7 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     mag = (mag >> 9) + turns * (kTurnQ29 >> 9);
     // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees) and kMaxPieceTicks long (sweep x
     // radius ticks).
-    uint32_t rmax = (a_.radii[0] > a_.radii[1] ? a_.radii[0] : a_.radii[1]) >> 8;
+    uint32_t rmax = larger(a_.radii) >> 8;
     // (x / 3 for x = mag / 2^17 below 2^14, by its reciprocal: a division is a library call.)
     uint32_t n = ((mag >> 17) * 21846ul >> 16) + 1u;
     uint32_t by_length = Num(mag, -20).mul(rmax + 1).div(kMaxPieceTicks).u32() + 1;
@@ -965,12 +970,8 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     int8_t scale;
     uint32_t span = kOneQ29, widest = kWidestBezierQ29;
     uint8_t turns = 0;
-    bool circle = false;
-    // The length, and |dw| (a circular helix' length is their root sum of squares).
-    Num ld[2];
-    Num& len = ld[0]; // (set below: an arc's in closed form, or by quadrature)
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
-    k.rise = ld[1].set(uabs(dw_um));
+    k.rise.set(uabs(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
         k.clockwise = cp.clockwise != 0;
@@ -979,17 +980,13 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         if (span == 0) return false; // a null radius
         widest = kWidestArcQ29;
         turns = cp.turns;
-        len.set(kTurnQ29, -29).mul(turns).add(Num(span, -29));
         // w rises linearly with the angle: dw / |sweep| per radian.
-        k.rise.div(len);
+        k.rise.div(Num(kTurnQ29, -29).mul(turns).add(Num(span, -29)));
         memcpy(k.e.r, r, sizeof(k.e.r));
         scale = normalise(k.e.r, 2);
-        const uint32_t lo = r[0] < r[1] ? r[0] : r[1];
-        const uint32_t hi = r[0] ^ r[1] ^ lo;
+        const uint32_t hi = larger(r);
+        const uint32_t lo = r[0] ^ r[1] ^ hi;
         out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
-        circle = lo == hi;
-        len.mul(lo); // a circle: r |sweep|, and a helix: sqrt(plane^2 + dw^2)
-        if (w_regulated) len = root_sum_squares(ld, 2);
     } else {
         // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
@@ -1006,12 +1003,12 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     k.rise.shift(scale);
     k.w_counts = w_regulated;
     tangent(k, out.start_dir);
-    if (!circle) { // ellipses and Beziers by quadrature
-        len = track_length(k, span, widest);
-        // An ellipse's extra turns: a full turn from wherever.
-        if (turns) len.add(track_length(k, kTurnQ29, widest).mul(turns));
-        len.div(18).shift(static_cast<int8_t>(-29 - scale));
-    }
+    // Circles too: their speed is constant, so the quadrature gives r |sweep| (and a helix'
+    // sqrt(plane^2 + dw^2)).
+    Num len = track_length(k, span, widest);
+    // An arc's extra turns: a full turn from wherever.
+    if (turns) len.add(track_length(k, kTurnQ29, widest).mul(turns));
+    len.div(18).shift(static_cast<int8_t>(-29 - scale));
     if (k.bezier) {
         out.min_radius_um = k.rmin.shift(static_cast<int8_t>(-scale)).u32(); // none: saturates
     } else {
