@@ -889,11 +889,13 @@ __attribute__((noinline)) Num norm(const int32_t v[2], const Track& k, bool with
 // end arm is null), P' a little inside the curve (2^-12 of t): the direction of P''(0), or of
 // -P''(1), to 2^-12 |P'''| / |P''| rad.
 void tangent(Track& k, int32_t out[3]) {
-    int32_t d[2], d2[2];
-    track_at(k, 0, false, d, d2);
+    // P' and P'' where probe() keeps them.
+    int32_t* d = scratch<int32_t[4], kCurveProbeAt>();
+    asm("" : "+r"(d));
+    track_at(k, 0, false, d, d + 2);
     if ((d[0] | d[1]) == 0) {
         const uint32_t in = kOneQ29 >> 12; // backwards from t = 1: modulo 2^32
-        track_at(k, k.b.t ? static_cast<uint32_t>(0u - in) : in, false, d, d2);
+        track_at(k, k.b.t ? static_cast<uint32_t>(0u - in) : in, false, d, d + 2);
     }
     Num q[3];
     const uint8_t neg = components(d, k.rise, q);
@@ -909,9 +911,9 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
     // P' and P'' in the scratch RAM (scratch.h: dead there under push_line()), not in a frame
     // on the deepest stack of the firmware.
     static_assert(4 * sizeof(int32_t) <= kCurveProbeBytes, "P' and P'' fit their share");
-    int32_t(&d)[4] = scratch<int32_t[4], kCurveProbeAt>();
-    int32_t* const d1 = d;
-    int32_t* const d2 = d + 2;
+    int32_t* d1 = scratch<int32_t[4], kCurveProbeAt>();
+    asm("" : "+r"(d1)); // (reached through a pointer register: lds/sts are 4 bytes)
+    int32_t* const d2 = d1 + 2;
     track_at(k, off, move, d1, d2);
     Num n1 = norm(d1, k, false);
     if (k.bezier) {
