@@ -467,6 +467,19 @@ __attribute__((noinline)) int64_t add_turn(int64_t x) {
     return x + kTurnQ29;
 }
 
+// On the ellipse of semi-axes r at the direction v = (cos t, sin t) (Q30): the tangent
+// (-ru sin t, rv cos t), reversed with `back`, and the radius (ru cos t, rv sin t) (the point
+// seen from the centre, and -P''). The walker's pieces and the planner's track both use it.
+__attribute__((noinline)) void ellipse_at(const int32_t r[2], const int32_t v[2], bool back,
+                                          int32_t tangent[2], int32_t radius[2]) {
+    for (uint8_t i = 0; i < 2; ++i) {
+        int32_t a = v[1 - i];
+        if (i == back) a = -a;
+        tangent[i] = mul_q30(r[i], a);
+        radius[i] = mul_q30(r[i], v[i]);
+    }
+}
+
 } // namespace
 
 void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], int32_t& c,
@@ -543,10 +556,10 @@ void CurveWalker::start_piece(Piece& g) {
 void CurveWalker::arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const {
     // X = cu + ru cos t, Y = cv + rv sin t; the arm is the tangent (-ru sin t, rv cos t) times
     // 4 tan(h/4).
+    ellipse_at(reinterpret_cast<const int32_t*>(a_.radii), dir, false, arm, point);
     for (uint8_t k = 0; k < 2; ++k) {
-        int32_t r = static_cast<int32_t>(a_.radii[k]);
-        point[k] = a_.centre[k] + mul_q30(r, dir[k]);
-        arm[k] = mul_q30(mul_q30(r, k ? dir[0] : -dir[1]), a_.arm);
+        point[k] += a_.centre[k];
+        arm[k] = mul_q30(arm[k], a_.arm);
     }
 }
 
@@ -868,14 +881,8 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
         rotate(v, rot);
     }
     if (move) memcpy(k.e.dir[0], v, sizeof(v));
-    // (-ru sin t, rv cos t), reversed when clockwise, and (ru cos t, rv sin t) (-P'': only its
-    // size is used).
-    for (uint8_t i = 0; i < 2; ++i) {
-        int32_t a = v[1 - i];
-        if (i == k.clockwise) a = -a;
-        d1[i] = mul_q30(k.e.r[i], a);
-        d2[i] = mul_q30(k.e.r[i], v[i]);
-    }
+    // (-P'': only its size is used.)
+    ellipse_at(k.e.r, v, k.clockwise, d1, d2);
 }
 
 // |(x, y)| for signed x, y, or with `with_rise` |(x, y, rise)|.
