@@ -323,10 +323,11 @@ __attribute__((noinline)) uint32_t arc_directions(const int32_t ends[2][2], cons
                                                   const uint32_t radii[2], bool clockwise,
                                                   int32_t dir[2][2]) {
     if (radii[0] == 0 || radii[1] == 0) return 0;
-    for (uint8_t e = 0; e < 2; ++e) {
-        for (uint8_t k = 0; k < 2; ++k) dir[e][k] = ends[e][k] - centre[k];
-        direction_of(dir[e], radii);
-    }
+    const int32_t* p = ends[0];
+    int32_t* v = dir[0];
+    for (uint8_t i = 0; i < 4; ++i) v[i] = p[i] - centre[i & 1];
+    direction_of(dir[0], radii);
+    direction_of(dir[1], radii);
     return sweep_of(dir, clockwise);
 }
 
@@ -1001,9 +1002,20 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
         // these fit. w rises by dw per unit of t.
         for (uint8_t i = 0; i < 2; ++i) {
-            int32_t q[4] = {cp.start_um[i], cp.a_um[i], cp.b_um[i], cp.end_um[i]};
+            // The points start, a, b, end: 0, 2, 3, 1 of the row (start end a b, as the G-code
+            // checks pin it), 2 bits each.
+            int32_t q[4];
+            const int32_t* row = cp.start_um;
+            for (uint8_t j = 0, seq = 0x78; j < 4; ++j, seq = static_cast<uint8_t>(seq >> 2)) {
+                q[j] = row[2 * (seq & 3) + i];
+            }
             differences(q);
-            for (uint8_t j = 0; j < 3; ++j) k.b.h[j][i] = (j == 1 ? 6 : 3) * q[j + 1];
+            for (uint8_t j = 0; j < 3; ++j) {
+                int32_t h = q[j + 1];
+                h += h + h; // (products are library calls)
+                if (j == 1) h += h;
+                k.b.h[j][i] = h;
+            }
         }
         scale = normalise(&k.b.h[0][0], 6);
         k.bezier = true;
