@@ -178,11 +178,6 @@ __attribute__((always_inline)) inline void save_run_to_r17() {
 #endif
 }
 
-// abs32 out of line: inline, each of its many uses costs 18 bytes on the AVR.
-__attribute__((noinline)) uint32_t uabs(int32_t v) {
-    return abs32(v);
-}
-
 // Forward differences in place: (p0, p1, p2, p3) -> (p0, p1 - p0, p2 - 2 p1 + p0, p3 - 3 p2 + ...).
 #if defined(__AVR__)
 // In assembly: passes of 3, 2 and 1 subtractions q[j] -= q[j - 1] from j = 3 down, byte by byte
@@ -287,8 +282,8 @@ __attribute__((noinline)) uint32_t larger(const uint32_t r[2]) {
 // q = (|v0|, |v1|, third); returns the signs of v0 and v1 (bits 0 and 1).
 __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& third, Num q[3]) {
     q[2] = third;
-    q[1].set(uabs(v[1]));
-    q[0].set(uabs(v[0]));
+    q[1].set(abs32(v[1]));
+    q[0].set(abs32(v[0]));
     uint8_t neg = v[1] < 0 ? 2 : 0;
     if (v[0] < 0) ++neg;
     return neg;
@@ -623,7 +618,7 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
         int32_t d[4];
         for (uint8_t i = 0; i < 4; ++i) d[i] = (pts_[k][i] = src[i][k]) >> 8;
         differences(d);
-        uint32_t b = uabs(d[1]) + 2 * uabs(d[2]) + uabs(d[3]);
+        uint32_t b = abs32(d[1]) + 2 * abs32(d[2]) + abs32(d[3]);
         if (b > bound) bound = b;
     }
     bound *= 3;
@@ -848,7 +843,7 @@ inline int8_t normalise(int32_t* v, uint8_t n) {
 #else
 int8_t normalise(int32_t* v, uint8_t n) {
     uint32_t big = 0;
-    for (uint8_t i = 0; i < n; ++i) big |= uabs(v[i]); // the largest's top bit
+    for (uint8_t i = 0; i < n; ++i) big |= abs32(v[i]); // the largest's top bit
     if (big == 0) return 0;
     // big = m 2^e with m in [2^31, 2^32): its top bit is 31 + e, to be moved to bit 27.
     const int8_t sh = static_cast<int8_t>(-4 - Num(big).e);
@@ -930,7 +925,7 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
         int32_t cross = mul_q30(d1[0], d2[1]) - mul_q30(d1[1], d2[0]);
         if (cross != 0) {
             Num rc = n1;
-            rc.mul(n1).mul(n1).div(uabs(cross)).shift(-30);
+            rc.mul(n1).mul(n1).div(abs32(cross)).shift(-30);
             if (rc.cmp(k.rmin) < 0) k.rmin = rc;
         }
     }
@@ -981,7 +976,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     uint32_t span = kOneQ29, widest = kWidestBezierQ29;
     uint8_t turns = 0;
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
-    k.rise.set(uabs(dw_um));
+    k.rise.set(abs32(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
         k.clockwise = cp.clockwise != 0;
