@@ -282,10 +282,12 @@ __attribute__((noinline)) uint32_t larger(const uint32_t r[2]) {
 // q = (|v0|, |v1|, third); returns the signs of v0 and v1 (bits 0 and 1).
 __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& third, Num q[3]) {
     q[2] = third;
-    q[1].set(abs32(v[1]));
-    q[0].set(abs32(v[0]));
-    uint8_t neg = v[1] < 0 ? 2 : 0;
-    if (v[0] < 0) ++neg;
+    uint8_t neg = 0;
+    for (uint8_t i = 2; i-- > 0;) {
+        neg = static_cast<uint8_t>(neg << 1);
+        if (v[i] < 0) ++neg;
+        q[i].set(abs32(v[i]));
+    }
     return neg;
 }
 
