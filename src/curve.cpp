@@ -748,8 +748,9 @@ struct Track {
             int32_t h[3][2]; ///< B'(t) = h0 + t (h1 + t h2)
         } b;                 ///< Bezier
     };
-    Num rise; ///< |dw / dparameter|: the helix' rise
-    Num rmin; ///< Bezier: smallest radius of curvature met so far (at first 2^100: none)
+    Num rise;      ///< |dw / dparameter|: the helix' rise
+    Num rmin;      ///< Bezier: smallest radius of curvature met so far (at first 2^100: none)
+    uint32_t half; ///< |P'| / |P''| / 2 at the end of the last panel, Q29 (track_length())
 };
 
 // Shifts v[0..n-1] (n >= 1) left or right so that the largest magnitude is in [2^27, 2^28); the
@@ -951,12 +952,12 @@ Num track_length(Track& track, uint32_t span, uint32_t widest) {
     asm("" : "+r"(kp));
     Track& k = *kp;
     Num total{};
-    uint32_t half, w = 0;
+    uint32_t w = 0;
     for (;;) {
-        probe(k, w, true, &half); // the end of the last panel (at first, the start: w = 0)
+        probe(k, w, true, &k.half); // the end of the last panel (at first, the start: w = 0)
         span -= w;
         if (span == 0) break;
-        w = half; // in a register: half's address is taken
+        w = k.half;
         if (w > widest) w = widest;
         if (w < kNarrowestQ29) w = kNarrowestQ29;
         if (w > span) w = span;
