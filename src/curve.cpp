@@ -656,18 +656,23 @@ bool CurveWalker::next_piece() {
     }
     p3[2] = w3 + w0_q8_;
     arm0[2] = arm3[2] = p3[2] - prev_q8_[2];
-    if (kind_ == 1) {
-        int32_t* dir = a_.dir[0];
-        arc_at(dir, p3, arm0);
-        rotate(dir, a_.rot);
-        if (last) memcpy(dir, a_.dir[1], sizeof(a_.dir[1])); // no drift left over
-        arc_at(dir, p3, arm3);
-    } else {
-        // Bezier part [a, a + 1/n]: the curve's ends and tangents.
-        bezier_at(index, p3, arm0); // (its point, the last piece's end, is overwritten)
-        // (At a = 1 every step of de Casteljau's algorithm gives its right point exactly: the
-        // last piece ends on the commanded end.)
-        bezier_at(static_cast<uint16_t>(index + 1), p3, arm3);
+    // The start of the piece (s = 0) and its end (s = 1): the point, overwritten at the end, and
+    // the arm. An arc's direction turns by a piece between them; a Bezier part is [a, a + 1/n].
+    int32_t* dir = a_.dir[0];
+    for (uint8_t s = 0; s < 2; ++s) {
+        static_assert(kArm0 == 0 && kArm3 == 2, "the arms at both ends");
+        int32_t* arm = g.v[2 * s];
+        if (kind_ != 1) {
+            // (At a = 1 every step of de Casteljau's algorithm gives its right point exactly:
+            // the last piece ends on the commanded end.)
+            bezier_at(static_cast<uint16_t>(index + s), p3, arm);
+            continue;
+        }
+        if (s) {
+            rotate(dir, a_.rot);
+            if (last) memcpy(dir, a_.dir[1], sizeof(a_.dir[1])); // no drift left over
+        }
+        arc_at(dir, p3, arm);
     }
     start_piece(g);
     return true;
