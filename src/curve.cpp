@@ -496,10 +496,10 @@ int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clock
     return clockwise ? -sweep : sweep;
 }
 
-void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
+void CurveWalker::begin(const Ends& e, uint8_t kind) {
     memcpy(pos, e.start, sizeof(pos));
     memcpy(end_, e.end, sizeof(end_));
-    memcpy(prev_q8_, p0_q8, 2 * sizeof(prev_q8_[0]));
+    // (The start of the curve in the plane, prev_q8_[0..1], is set by next_piece().)
     // w moves linearly along the curve (a helix); without it, only u and v are walked.
     prev_q8_[2] = w0_q8_ = e.start[2] * 256;
     dw_q8_ = e.end[2] * 256 - w0_q8_;
@@ -587,9 +587,7 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     rotation(h, a_.rot);
     int32_t x = h >> 2;
     a_.arm = 4 * mul_q30(x, series(2, mul_q30(x, x)));
-    int32_t p[2], arm[2];
-    arc_at(a_.dir[0], p, arm);
-    begin(e, p, 1);
+    begin(e, 1);
     return true;
 }
 
@@ -634,7 +632,7 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
     }
     log_pieces_ = j;
     piece_count_ = pieces_ = n;
-    begin(e, e.start_q8, 2);
+    begin(e, 2);
     return true;
 }
 
@@ -662,17 +660,20 @@ bool CurveWalker::next_piece() {
     for (uint8_t s = 0; s < 2; ++s) {
         static_assert(kArm0 == 0 && kArm3 == 2, "the arms at both ends");
         int32_t* arm = g.v[2 * s];
+        // Where the piece starts (s = 0): the last one's end, computed the same way; the first
+        // piece's, the arc at its start direction, or B(0) = P0 exactly.
+        int32_t* point = s ? p3 : prev_q8_;
         if (kind_ != 1) {
             // (At a = 1 every step of de Casteljau's algorithm gives its right point exactly:
             // the last piece ends on the commanded end.)
-            bezier_at(static_cast<uint16_t>(index + s), p3, arm);
-            continue;
+            bezier_at(static_cast<uint16_t>(index + s), point, arm);
+        } else {
+            if (s) {
+                rotate(dir, a_.rot);
+                if (last) memcpy(dir, a_.dir[1], sizeof(a_.dir[1])); // no drift left over
+            }
+            arc_at(dir, point, arm);
         }
-        if (s) {
-            rotate(dir, a_.rot);
-            if (last) memcpy(dir, a_.dir[1], sizeof(a_.dir[1])); // no drift left over
-        }
-        arc_at(dir, p3, arm);
     }
     start_piece(g);
     return true;
