@@ -551,7 +551,8 @@ __attribute__((always_inline)) inline void CurveWalker::start_piece(Piece& g) {
     }
 }
 
-void CurveWalker::arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const {
+__attribute__((always_inline)) inline void
+CurveWalker::arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const {
     // X = cu + ru cos t, Y = cv + rv sin t; the arm is the tangent (-ru sin t, rv cos t) times
     // 4 tan(h/4).
     ellipse_at(reinterpret_cast<const int32_t*>(a_.radii), dir, false, arm, point);
