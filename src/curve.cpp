@@ -496,7 +496,8 @@ int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clock
     return clockwise ? -sweep : sweep;
 }
 
-void CurveWalker::begin(const Ends& e, uint8_t kind) {
+void CurveWalker::begin(const Ends& e, uint16_t pieces, uint8_t kind) {
+    piece_count_ = pieces_ = pieces;
     memcpy(pos, e.start, sizeof(pos));
     memcpy(end_, e.end, sizeof(end_));
     // (The start of the curve in the plane, prev_q8_[0..1], is set by next_piece().)
@@ -580,7 +581,6 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     uint32_t by_length = Num(mag, -20).mul(rmax + 1).div(kMaxPieceTicks).u32() + 1;
     if (by_length > n) n = by_length;
     if (n > 0xFFFF) return false;
-    piece_count_ = pieces_ = static_cast<uint16_t>(n);
     // Piece angle h, Q30 (at most 21.5 degrees, so the series apply), and 3 x the arm of its
     // cubic per unit of radius, 4 tan(h/4).
     int32_t h = static_cast<int32_t>(div_frac(mag, n, 10));
@@ -588,7 +588,7 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     rotation(h, a_.rot);
     int32_t x = h >> 2;
     a_.arm = 4 * mul_q30(x, series(2, mul_q30(x, x)));
-    begin(e, 1);
+    begin(e, static_cast<uint16_t>(n), 1);
     return true;
 }
 
@@ -632,8 +632,7 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
         n = static_cast<uint16_t>(n << 1);
     }
     log_pieces_ = j;
-    piece_count_ = pieces_ = n;
-    begin(e, 2);
+    begin(e, n, 2);
     return true;
 }
 

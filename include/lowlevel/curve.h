@@ -110,7 +110,7 @@ class CurveWalker {
     int32_t pos[3]; ///< current position, ticks (u, v, w)
 
   private:
-    void begin(const Ends& e, uint8_t kind);
+    void begin(const Ends& e, uint16_t pieces, uint8_t kind);
     bool next_piece();
     /// A piece: 3 x its arm at the start, its end and 3 x its arm at the end, ticks x 256 (u, v,
     /// w); start_piece() turns the three into the cubic's coefficients c1, c2, c3 in place.
