@@ -948,9 +948,9 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
 // Length of the track over `span` (Q29) from its current point, x 2^29 x 18 x 2^scale: panels
 // of 3 Gauss-Legendre nodes, each at most half the local scale |P'| / |P''| wide (so that the
 // nearest singularity of |P'| in the complex plane is at least two widths away: 1e-7 relative),
-// and at most `widest`. On a Bezier, the radii of curvature are sampled at every node and panel
-// end, and these crowd where the curve turns tightly.
-Num track_length(Track& track, uint32_t span, uint32_t widest) {
+// and at most kWidestArcQ29 or kWidestBezierQ29. On a Bezier, the radii of curvature are sampled at
+// every node and panel end, and these crowd where the curve turns tightly.
+Num track_length(Track& track, uint32_t span) {
     // The track's address as a pointer the callees cannot see through (it is a constant,
     // scratch.h): probe() and track_at() then reach it with displacements from a pointer
     // register (2 bytes an instruction), not at absolute addresses (lds/sts, 4 bytes).
@@ -964,6 +964,7 @@ Num track_length(Track& track, uint32_t span, uint32_t widest) {
         span -= w;
         if (span == 0) break;
         w = k.half;
+        const uint32_t widest = k.bezier ? kWidestBezierQ29 : kWidestArcQ29;
         if (w > widest) w = widest;
         if (w < kNarrowestQ29) w = kNarrowestQ29;
         if (w > span) w = span;
@@ -982,7 +983,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
                                      CurveShape& out, Track& k) {
     k.w_down = dw_um < 0;
     int8_t scale;
-    uint32_t span = kOneQ29, widest = kWidestBezierQ29;
+    uint32_t span = kOneQ29;
     uint8_t turns = 0;
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
     k.rise.set(abs32(dw_um));
@@ -992,7 +993,6 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         // The sweep in (0, 2 pi], and with the extra full turns, radians.
         span = arc_directions(ends_of(cp), cp.a_um, r, k.clockwise, k.e.dir);
         if (span == 0) return false; // a null radius
-        widest = kWidestArcQ29;
         turns = cp.turns;
         // w rises linearly with the angle: dw / |sweep| per radian.
         k.rise.div(Num(kTurnQ29, -29).mul(turns).add(Num(span, -29)));
@@ -1030,9 +1030,9 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     tangent(k, out.start_dir);
     // Circles too: their speed is constant, so the quadrature gives r |sweep| (and a helix'
     // sqrt(plane^2 + dw^2)).
-    Num len = track_length(k, span, widest);
+    Num len = track_length(k, span);
     // An arc's extra turns: a full turn from wherever.
-    if (turns) len.add(track_length(k, kTurnQ29, widest).mul(turns));
+    if (turns) len.add(track_length(k, kTurnQ29).mul(turns));
     len.div(18).shift(static_cast<int8_t>(-29 - scale));
     if (k.bezier) {
         out.min_radius_um = k.rmin.shift(static_cast<int8_t>(-scale)).u32(); // none: saturates
