@@ -871,9 +871,10 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
         if (move) k.b.t = t;
         int32_t t30 = static_cast<int32_t>(t << 1);
         for (uint8_t i = 0; i < 2; ++i) {
-            int32_t q = k.b.h[1][i] + mul_q30(k.b.h[2][i], t30);
+            const int32_t a = mul_q30(k.b.h[2][i], t30);
+            const int32_t q = k.b.h[1][i] + a;
+            d2[i] = q + a;
             d1[i] = k.b.h[0][i] + mul_q30(q, t30);
-            d2[i] = q + mul_q30(k.b.h[2][i], t30);
         }
         return;
     }
