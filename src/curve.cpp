@@ -943,7 +943,8 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
         Num n2 = norm(d2, k, false);
         *half = n2.m ? Num(n1).div(n2).shift(28).u32() : 0xFFFFFFFFul; // P'' = 0: a line
     }
-    return k.w_counts ? norm(d1, k, true) : n1;
+    if (k.w_counts) n1 = norm(d1, k, true);
+    return n1;
 }
 
 // Length of the track over `span` (Q29) from its current point, x 2^29 x 18 x 2^scale: panels
