@@ -947,19 +947,19 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
     return n1;
 }
 
-// Length of the track over `span` (Q29) from its current point, x 2^29 x 18 x 2^scale: panels
-// of 3 Gauss-Legendre nodes, each at most half the local scale |P'| / |P''| wide (so that the
-// nearest singularity of |P'| in the complex plane is at least two widths away: 1e-7 relative),
-// and at most kWidestArcQ29 or kWidestBezierQ29. On a Bezier, the radii of curvature are sampled at
-// every node and panel end, and these crowd where the curve turns tightly.
-Num track_length(Track& track, uint32_t span) {
+// Adds to `total` the length of the track over `span` (Q29) from its current point, x 2^29 x 18
+// x 2^scale: panels of 3 Gauss-Legendre nodes, each at most half the local scale |P'| / |P''|
+// wide (so that the nearest singularity of |P'| in the complex plane is at least two widths
+// away: 1e-7 relative), and at most kWidestArcQ29 or kWidestBezierQ29. On a Bezier, the radii of
+// curvature are sampled at every node and panel end, and these crowd where the curve turns
+// tightly.
+void track_length(Track& track, uint32_t span, Num& total) {
     // The track's address as a pointer the callees cannot see through (it is a constant,
     // scratch.h): probe() and track_at() then reach it with displacements from a pointer
     // register (2 bytes an instruction), not at absolute addresses (lds/sts, 4 bytes).
     Track* kp = &track;
     asm("" : "+r"(kp));
     Track& k = *kp;
-    Num total{};
     uint32_t w = 0;
     for (;;) {
         probe(k, w, true, &k.half); // the end of the last panel (at first, the start: w = 0)
@@ -976,7 +976,6 @@ Num track_length(Track& track, uint32_t span) {
         sum.add(probe(k, w - g, false, nullptr)).mul(5).add(probe(k, w / 2, false, nullptr).mul(8));
         total.add(sum.mul(w));
     }
-    return total;
 }
 
 // curve_shape() with its track passed in: the track is then reached through a pointer, not
@@ -1032,9 +1031,14 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     tangent(k, out.start_dir);
     // Circles too: their speed is constant, so the quadrature gives r |sweep| (and a helix'
     // sqrt(plane^2 + dw^2)).
-    Num len = track_length(k, span);
+    Num len{};
+    track_length(k, span, len);
     // An arc's extra turns: a full turn from wherever.
-    if (turns) len.add(track_length(k, kTurnQ29).mul(turns));
+    if (turns) {
+        Num full{};
+        track_length(k, kTurnQ29, full);
+        len.add(full.mul(turns));
+    }
     len.div(18).shift(static_cast<int8_t>(-29 - scale));
     if (k.bezier) {
         out.min_radius_um = k.rmin.shift(static_cast<int8_t>(-scale)).u32(); // none: saturates
