@@ -252,21 +252,22 @@ void rotate(int32_t v[2], const int32_t rot[2]) {
     v[0] = c;
 }
 
-// sqrt(q0^2 + ... + q(n-1)^2).
-__attribute__((noinline)) Num root_sum_squares(const Num* q, uint8_t n) {
-    Num sum{};
+// sum = sqrt(q0^2 + ... + q(n-1)^2) (written, not returned: no copies through the frames).
+__attribute__((noinline)) void root_sum_squares(const Num* q, uint8_t n, Num& sum) {
+    sum.m = 0;
     for (uint8_t i = 0; i < n; ++i) {
         Num t = q[i];
         sum.add(t.mul(q[i]));
     }
-    return sum.sqrt();
+    sum.sqrt();
 }
 
 // out[i] = q[i] / |q| for the n components of q, `bits` fraction bits, negated where bit i of
 // `neg` is set; 0 for q = 0 (a quotient by zero is zero). The q are overwritten.
 __attribute__((noinline)) void unit_vector(Num* q, uint8_t n, uint8_t neg, uint8_t bits,
                                            int32_t* out) {
-    const Num norm = root_sum_squares(q, n);
+    Num norm;
+    root_sum_squares(q, n, norm);
     for (uint8_t i = 0, bit = 1; i < n; ++i, bit = static_cast<uint8_t>(bit << 1)) {
         uint32_t u = q[i].div(norm).shift(static_cast<int8_t>(bits)).u32(); // (q is spent)
         if (u > (1ul << bits)) u = 1ul << bits;
@@ -892,10 +893,10 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
 }
 
 // |(x, y)| for signed x, y, or with `with_rise` |(x, y, rise)|.
-__attribute__((noinline)) Num norm(const int32_t v[2], const Track& k, bool with_rise) {
+__attribute__((noinline)) void norm(const int32_t v[2], const Track& k, bool with_rise, Num& r) {
     Num q[3];
     components(v, k.rise, q);
-    return root_sum_squares(q, static_cast<uint8_t>(2 + with_rise));
+    root_sum_squares(q, static_cast<uint8_t>(2 + with_rise), r);
 }
 
 // The unit tangent (P', w') / |(P', w')| at the current point, Q29. Where P' = 0 (a Bezier whose
@@ -928,7 +929,8 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
     asm("" : "+r"(d1)); // (reached through a pointer register: lds/sts are 4 bytes)
     int32_t* const d2 = d1 + 2;
     track_at(k, off, move, d1, d2);
-    Num n1 = norm(d1, k, false);
+    Num n1;
+    norm(d1, k, false, n1);
     if (k.bezier) {
         // |P' x P''| / 2^30: both are below 2^30, and where the radius is smallest this keeps 20
         // bits.
@@ -940,10 +942,11 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
         }
     }
     if (half) {
-        Num n2 = norm(d2, k, false);
+        Num n2;
+        norm(d2, k, false, n2);
         *half = n2.m ? Num(n1).div(n2).shift(28).u32() : 0xFFFFFFFFul; // P'' = 0: a line
     }
-    if (k.w_counts) n1 = norm(d1, k, true);
+    if (k.w_counts) norm(d1, k, true, n1);
     return n1;
 }
 
