@@ -917,10 +917,11 @@ void tangent(Track& k, int32_t out[3]) {
 }
 
 // The track at `off` (Q29) past its current point, which with `move` becomes the current one:
-// returns the speed sqrt(|P'|^2 + w'^2) (x 2^scale) and, with `half`, |P'| / |P''| / 2 (Q29: the
-// widest panel there). On a Bezier, the radius of curvature |P'|^3 / |P' x P''| (x 2^scale) there
+// the speed sqrt(|P'|^2 + w'^2) (x 2^scale) into `n1` (written where the caller keeps it, not
+// returned: no copies through the frames) and, with `half`, |P'| / |P''| / 2 (Q29: the widest
+// panel there). On a Bezier, the radius of curvature |P'|^3 / |P' x P''| (x 2^scale) there
 // is kept in k.rmin when it is the smallest so far.
-Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
+void probe(Track& k, uint32_t off, bool move, uint32_t* half, Num& n1) {
     save_run_from_r8();
     // P' and P'' in the scratch RAM (scratch.h: dead there under push_line()), not in a frame
     // on the deepest stack of the firmware.
@@ -929,7 +930,6 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
     asm("" : "+r"(d1)); // (reached through a pointer register: lds/sts are 4 bytes)
     int32_t* const d2 = d1 + 2;
     track_at(k, off, move, d1, d2);
-    Num n1;
     norm(d1, k, false, n1);
     if (k.bezier) {
         // |P' x P''| / 2^30: both are below 2^30, and where the radius is smallest this keeps 20
@@ -947,7 +947,6 @@ Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
         *half = n2.m ? Num(n1).div(n2).shift(28).u32() : 0xFFFFFFFFul; // P'' = 0: a line
     }
     if (k.w_counts) norm(d1, k, true, n1);
-    return n1;
 }
 
 // Adds to `total` the length of the track over `span` (Q29) from its current point, x 2^29 x 18
@@ -965,7 +964,8 @@ void track_length(Track& track, uint32_t span, Num& total) {
     Track& k = *kp;
     uint32_t w = 0;
     for (;;) {
-        probe(k, w, true, &k.half); // the end of the last panel (at first, the start: w = 0)
+        Num sum, b, mid;
+        probe(k, w, true, &k.half, sum); // the end of the last panel (at first, the start)
         span -= w;
         if (span == 0) break;
         w = k.half;
@@ -975,8 +975,10 @@ void track_length(Track& track, uint32_t span, Num& total) {
         if (w > span) w = span;
         // Nodes at g, w / 2 and w - g, weights 5, 8, 5 (/ 18).
         const uint32_t g = static_cast<uint32_t>(mul_q30(static_cast<int32_t>(w), kGaussQ30));
-        Num sum = probe(k, g, false, nullptr);
-        sum.add(probe(k, w - g, false, nullptr)).mul(5).add(probe(k, w / 2, false, nullptr).mul(8));
+        probe(k, g, false, nullptr, sum);
+        probe(k, w - g, false, nullptr, b);
+        probe(k, w / 2, false, nullptr, mid);
+        sum.add(b).mul(5).add(mid.mul(8));
         total.add(sum.mul(w));
     }
 }
