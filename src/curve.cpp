@@ -620,7 +620,9 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
         int32_t d[4];
         for (uint8_t i = 0; i < 4; ++i) d[i] = (pts_[k][i] = src[i][k]) >> 8;
         differences(d);
-        uint32_t b = abs32(d[1]) + 2 * abs32(d[2]) + abs32(d[3]);
+        uint32_t b = abs32(d[2]);
+        b += b + abs32(d[1]);
+        b += abs32(d[3]);
         if (b > bound) bound = b;
     }
     bound *= 3;
