@@ -694,7 +694,7 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
         if (!next_piece()) kind_ = 0;
     }
     const bool walking = kind_ != 0;
-    const uint8_t axes = walking ? axes_ : 3;
+    const uint8_t axes = axes_; // (w never moves on a curve of two axes: its end is its start)
     uint8_t bits = 0, down = 0, bit = 1;
     for (uint8_t a = 0; a < axes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         int32_t p = end_[a];
