@@ -684,15 +684,10 @@ bool CurveWalker::next_piece() {
 
 bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
     save_run_from_r8();
-    if (left_ == 0) { // (a piece has at least one sample)
-        if (kind_ == 0) {
-            moved = neg = 0;
-            return false;
-        }
-        // Last step: from the rounded end of the curve to the exact target (at most one tick
-        // per axis: both are within 0.71 tick of the curve's end point).
-        if (!next_piece()) kind_ = 0;
-    }
+    // Past the last piece: the last step, from the rounded end of the curve to the exact target
+    // (at most one tick per axis: both are within 0.71 tick of the curve's end point); once made
+    // (the position is the end), no step and false.
+    if (left_ == 0 && kind_ != 0 && !next_piece()) kind_ = 0; // (a piece has a sample at least)
     const bool walking = kind_ != 0;
     const uint8_t axes = axes_; // (w never moves on a curve of two axes: its end is its start)
     uint8_t bits = 0, down = 0, bit = 1;
