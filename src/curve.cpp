@@ -753,7 +753,7 @@ struct Track {
         } b;                 ///< Bezier
     };
     Num rise;      ///< |dw / dparameter|: the helix' rise
-    Num rmin;      ///< Bezier: smallest radius of curvature met so far (at first 2^100: none)
+    Num rmin;      ///< Bezier: smallest radius of curvature met so far, x 2^30 (2^100: none)
     uint32_t half; ///< |P'| / |P''| / 2 at the end of the last panel, Q29 (track_length())
 };
 
@@ -916,7 +916,7 @@ void tangent(Track& k, int32_t out[3]) {
 // The track at `off` (Q29) past its current point, which with `move` becomes the current one:
 // the speed sqrt(|P'|^2 + w'^2) (x 2^scale) into `n1` (written where the caller keeps it, not
 // returned: no copies through the frames) and, with `half`, |P'| / |P''| / 2 (Q29: the widest
-// panel there). On a Bezier, the radius of curvature |P'|^3 / |P' x P''| (x 2^scale) there
+// panel there). On a Bezier, the radius of curvature |P'|^3 / |P' x P''| (x 2^scale x 2^30) there
 // is kept in k.rmin when it is the smallest so far.
 void probe(Track& k, uint32_t off, bool move, uint32_t* half, Num& n1) {
     save_run_from_r8();
@@ -930,11 +930,12 @@ void probe(Track& k, uint32_t off, bool move, uint32_t* half, Num& n1) {
     norm(d1, k, false, n1);
     if (k.bezier) {
         // |P' x P''| / 2^30: both are below 2^30, and where the radius is smallest this keeps 20
-        // bits.
+        // bits. The radius is kept x 2^30 (below 2^90: under the 2^100 of none), and shape()
+        // takes the 2^30 off with the scale.
         int32_t cross = mul_q30(d1[0], d2[1]) - mul_q30(d1[1], d2[0]);
         if (cross != 0) {
             Num rc = n1;
-            rc.mul(n1).mul(n1).div(abs32(cross)).shift(-30);
+            rc.mul(n1).mul(n1).div(abs32(cross));
             if (rc.cmp(k.rmin) < 0) k.rmin = rc;
         }
     }
@@ -1043,7 +1044,8 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     }
     len.div(18).shift(static_cast<int8_t>(-29 - scale));
     if (k.bezier) {
-        out.min_radius_um = k.rmin.shift(static_cast<int8_t>(-scale)).u32(); // none: saturates
+        // (x 2^30, see probe(); none saturates)
+        out.min_radius_um = k.rmin.shift(static_cast<int8_t>(-30 - scale)).u32();
     } else {
         memcpy(k.e.dir[0], k.e.dir[1], sizeof(k.e.dir[0]));
     }
