@@ -1042,7 +1042,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
         track_length(k, kTurnQ29, full);
         len.add(full.mul(turns));
     }
-    len.div(18).shift(static_cast<int8_t>(-29 - scale));
+    len.div(18).shift(static_cast<int8_t>(8 - 29 - scale)); // um x 256
     if (k.bezier) {
         // (x 2^30, see probe(); none saturates)
         out.min_radius_um = k.rmin.shift(static_cast<int8_t>(-30 - scale)).u32();
@@ -1051,7 +1051,7 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     }
     tangent(k, out.end_dir);
     if (len.m == 0) return false;
-    out.len_q8 = len.shift(8).u32();
+    out.len_q8 = len.u32();
     return true;
 }
 
