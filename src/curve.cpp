@@ -247,6 +247,7 @@ void rotation(int32_t h, int32_t rot[2]) {
 
 // v = (cos t, sin t) turned by the angle of rot, Q30.
 void rotate(int32_t v[2], const int32_t rot[2]) {
+    save_run_from_r8();
     int32_t c = mul_q30(v[0], rot[0]) - mul_q30(v[1], rot[1]);
     v[1] = mul_q30(v[1], rot[0]) + mul_q30(v[0], rot[1]);
     v[0] = c;
@@ -612,6 +613,7 @@ void CurveWalker::bezier_at(uint16_t at, int32_t point[2], int32_t arm[2]) const
 }
 
 bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2_q8[2]) {
+    save_run_to_r17();
     kind_ = 0;
     uint32_t bound = 0; // hodograph bound (power basis), ticks
     const int32_t* src[4] = {e.start_q8, p1_q8, p2_q8, e.end_q8};
@@ -864,6 +866,7 @@ int8_t normalise(int32_t* v, uint8_t n) {
 // P' and P'' (x 2^scale) at `off` (Q29) past the current point; with `move`, that point becomes
 // the current one.
 void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
+    save_run_to_r17();
     if (k.bezier) {
         uint32_t t = k.b.t + off;
         if (move) k.b.t = t;
