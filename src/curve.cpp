@@ -985,9 +985,9 @@ void track_length(Track& track, uint32_t span, Num& total) {
 }
 
 // curve_shape() with its track passed in: the track is then reached through a pointer, not
-// through a stack frame too large for the AVR's displacement addressing.
-__attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated,
-                                     CurveShape& out, Track& k) {
+// through a stack frame too large for the AVR's displacement addressing. (Inlined into
+// curve_shape(), its one caller: one call level fewer on the deepest stack.)
+bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out, Track& k) {
     k.w_down = dw_um < 0;
     int8_t scale;
     uint32_t span = kOneQ29;
