@@ -892,8 +892,9 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
     ellipse_at(k.e.r, v, k.clockwise, d1, d2);
 }
 
-// |(x, y)| for signed x, y, or with `with_rise` |(x, y, rise)|.
-__attribute__((noinline)) void norm(const int32_t v[2], const Track& k, bool with_rise, Num& r) {
+// |(x, y)| for signed x, y, or with `with_rise` |(x, y, rise)|. (Inlined into probe(): its frame
+// grows by q, but the call level, deeper, goes.)
+void norm(const int32_t v[2], const Track& k, bool with_rise, Num& r) {
     Num q[3];
     components(v, k.rise, q);
     root_sum_squares(q, static_cast<uint8_t>(2 + with_rise), r);
