@@ -4,6 +4,7 @@
 #include "lowlevel/pgm.h"
 #include "lowlevel/scratch.h"
 
+#include <stddef.h>
 #include <string.h>
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the walker reads the high word of int64");
@@ -177,11 +178,6 @@ __attribute__((always_inline)) inline void save_run_to_r17() {
 #endif
 }
 
-// abs32 out of line: inline, each of its many uses costs 18 bytes on the AVR.
-__attribute__((noinline)) uint32_t uabs(int32_t v) {
-    return abs32(v);
-}
-
 // Forward differences in place: (p0, p1, p2, p3) -> (p0, p1 - p0, p2 - 2 p1 + p0, p3 - 3 p2 + ...).
 #if defined(__AVR__)
 // In assembly: passes of 3, 2 and 1 subtractions q[j] -= q[j - 1] from j = 3 down, byte by byte
@@ -251,26 +247,28 @@ void rotation(int32_t h, int32_t rot[2]) {
 
 // v = (cos t, sin t) turned by the angle of rot, Q30.
 void rotate(int32_t v[2], const int32_t rot[2]) {
+    save_run_from_r8();
     int32_t c = mul_q30(v[0], rot[0]) - mul_q30(v[1], rot[1]);
     v[1] = mul_q30(v[1], rot[0]) + mul_q30(v[0], rot[1]);
     v[0] = c;
 }
 
-// sqrt(q0^2 + ... + q(n-1)^2).
-__attribute__((noinline)) Num root_sum_squares(const Num* q, uint8_t n) {
-    Num sum{};
+// sum = sqrt(q0^2 + ... + q(n-1)^2) (written, not returned: no copies through the frames).
+__attribute__((noinline)) void root_sum_squares(const Num* q, uint8_t n, Num& sum) {
+    sum.m = 0;
     for (uint8_t i = 0; i < n; ++i) {
         Num t = q[i];
         sum.add(t.mul(q[i]));
     }
-    return sum.sqrt();
+    sum.sqrt();
 }
 
 // out[i] = q[i] / |q| for the n components of q, `bits` fraction bits, negated where bit i of
 // `neg` is set; 0 for q = 0 (a quotient by zero is zero). The q are overwritten.
 __attribute__((noinline)) void unit_vector(Num* q, uint8_t n, uint8_t neg, uint8_t bits,
                                            int32_t* out) {
-    const Num norm = root_sum_squares(q, n);
+    Num norm;
+    root_sum_squares(q, n, norm);
     for (uint8_t i = 0, bit = 1; i < n; ++i, bit = static_cast<uint8_t>(bit << 1)) {
         uint32_t u = q[i].div(norm).shift(static_cast<int8_t>(bits)).u32(); // (q is spent)
         if (u > (1ul << bits)) u = 1ul << bits;
@@ -278,26 +276,20 @@ __attribute__((noinline)) void unit_vector(Num* q, uint8_t n, uint8_t neg, uint8
     }
 }
 
-// |sweep| in (0, 2 pi] from the angle a0 to the angle a1 (radians x 2^29, in (-pi, pi]),
-// clockwise or not: a closed arc is a full turn. The difference is taken modulo 2^32, where the
-// result (below 2^32) is exact.
-uint32_t sweep_q29(int32_t a0, int32_t a1, bool clockwise) {
-    if (clockwise) {
-        int32_t t = a0;
-        a0 = a1;
-        a1 = t;
-    }
-    uint32_t d = static_cast<uint32_t>(a1) - static_cast<uint32_t>(a0);
-    return a1 > a0 ? d : d + kTurnQ29;
+// The larger of an ellipse's semi-axes.
+__attribute__((noinline)) uint32_t larger(const uint32_t r[2]) {
+    return r[0] > r[1] ? r[0] : r[1];
 }
 
 // q = (|v0|, |v1|, third); returns the signs of v0 and v1 (bits 0 and 1).
 __attribute__((noinline)) uint8_t components(const int32_t v[2], const Num& third, Num q[3]) {
     q[2] = third;
-    q[1].set(uabs(v[1]));
-    q[0].set(uabs(v[0]));
-    uint8_t neg = v[1] < 0 ? 2 : 0;
-    if (v[0] < 0) ++neg;
+    uint8_t neg = 0;
+    for (uint8_t i = 2; i-- > 0;) {
+        neg = static_cast<uint8_t>(neg << 1);
+        if (v[i] < 0) ++neg;
+        q[i].set(abs32(v[i]));
+    }
     return neg;
 }
 
@@ -311,28 +303,43 @@ __attribute__((noinline)) void direction_of(int32_t v[2], const uint32_t radii[2
     unit_vector(q, 2, neg, 30, v);
 }
 
-// ellipse_direction() of the point p seen from `centre`, into out = (cos t, sin t), Q30. (Not
-// inlined twice into arc_directions().)
-__attribute__((noinline)) void direction(const int32_t p[2], const int32_t centre[2],
-                                         const uint32_t radii[2], int32_t out[2]) {
-    out[0] = p[0] - centre[0];
-    out[1] = p[1] - centre[1];
-    direction_of(out, radii);
+// |sweep| in (0, 2 pi] from the direction dir[0] to dir[1] (Q30), clockwise or not (radians x
+// 2^29): a closed arc is a full turn. The difference of the angles (in (-pi, pi]) is taken
+// modulo 2^32, where the result (below 2^32) is exact; clockwise, from dir[1] to dir[0].
+__attribute__((noinline)) uint32_t sweep_of(const int32_t dir[2][2], bool clockwise) {
+    const int32_t* from = dir[clockwise];
+    const int32_t* to = dir[!clockwise];
+    const int32_t a0 = atan2_q29(from[1], from[0]);
+    const int32_t a1 = atan2_q29(to[1], to[0]);
+    const uint32_t d = static_cast<uint32_t>(a1) - static_cast<uint32_t>(a0);
+    return a1 > a0 ? d : d + kTurnQ29;
 }
 
-// Directions (cos t, sin t) of an arc's start and end seen from its centre in the ellipse's
-// scale (Q30), and its sweep without the extra turns (radians x 2^29, never 0); 0 for a null
-// radius.
-__attribute__((noinline)) uint32_t arc_directions(const int32_t start[2], const int32_t end[2],
-                                                  const int32_t centre[2], const uint32_t radii[2],
-                                                  bool clockwise, int32_t dir[2][2]) {
+// Directions (cos t, sin t) of an arc's start and end (`ends`: the two points in a row, as in
+// CurveParams and CurveWalker::Ends) seen from its centre in the ellipse's scale (Q30), and
+// |sweep| without the extra turns (radians x 2^29, never 0); 0 for a null radius.
+__attribute__((noinline)) uint32_t arc_directions(const int32_t ends[2][2], const int32_t centre[2],
+                                                  const uint32_t radii[2], bool clockwise,
+                                                  int32_t dir[2][2]) {
     if (radii[0] == 0 || radii[1] == 0) return 0;
-    direction(start, centre, radii, dir[0]);
-    direction(end, centre, radii, dir[1]);
-    // The signed sweep's low word (its magnitude is below 2^32).
-    const uint32_t sweep = static_cast<uint32_t>(
-        arc_sweep_q29(dir[0][0], dir[0][1], dir[1][0], dir[1][1], clockwise, 0));
-    return clockwise ? 0u - sweep : sweep;
+    const int32_t* p = ends[0];
+    int32_t* v = dir[0];
+    for (uint8_t i = 0; i < 4; ++i) v[i] = p[i] - centre[i & 1];
+    direction_of(dir[0], radii);
+    direction_of(dir[1], radii);
+    return sweep_of(dir, clockwise);
+}
+
+// The start and end points of a curve as a row of two (consecutive fields, pinned here).
+inline const int32_t (*ends_of(const CurveParams& c))[2] {
+    static_assert(offsetof(CurveParams, end_um) == offsetof(CurveParams, start_um) + 8,
+                  "start and end in a row");
+    return &c.start_um;
+}
+inline const int32_t (*ends_of(const CurveWalker::Ends& e))[2] {
+    static_assert(offsetof(CurveWalker::Ends, end_q8) == offsetof(CurveWalker::Ends, start_q8) + 8,
+                  "start and end in a row");
+    return &e.start_q8;
 }
 
 // One sample of a cubic by forward differencing: f += d1, d1 += d2, d2 += d3 (v = f, d1, d2, d3).
@@ -460,6 +467,19 @@ __attribute__((noinline)) int64_t add_turn(int64_t x) {
     return x + kTurnQ29;
 }
 
+// On the ellipse of semi-axes r at the direction v = (cos t, sin t) (Q30): the tangent
+// (-ru sin t, rv cos t), reversed with `back`, and the radius (ru cos t, rv sin t) (the point
+// seen from the centre, and -P''). The walker's pieces and the planner's track both use it.
+__attribute__((noinline)) void ellipse_at(const int32_t r[2], const int32_t v[2], bool back,
+                                          int32_t tangent[2], int32_t radius[2]) {
+    for (uint8_t i = 0; i < 2; ++i) {
+        int32_t a = v[1 - i];
+        if (i == back) a = -a;
+        tangent[i] = mul_q30(r[i], a);
+        radius[i] = mul_q30(r[i], v[i]);
+    }
+}
+
 } // namespace
 
 void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], int32_t& c,
@@ -472,15 +492,17 @@ void ellipse_direction(int32_t x_q8, int32_t y_q8, const uint32_t radii_q8[2], i
 
 int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clockwise,
                       uint8_t turns) {
-    int64_t sweep = sweep_q29(atan2_q29(s0, c0), atan2_q29(s1, c1), clockwise);
+    const int32_t dir[2][2] = {{c0, s0}, {c1, s1}};
+    int64_t sweep = sweep_of(dir, clockwise);
     while (turns--) sweep = add_turn(sweep);
     return clockwise ? -sweep : sweep;
 }
 
-void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
+void CurveWalker::begin(const Ends& e, uint16_t pieces, uint8_t kind) {
+    piece_count_ = pieces_ = pieces;
     memcpy(pos, e.start, sizeof(pos));
     memcpy(end_, e.end, sizeof(end_));
-    memcpy(prev_q8_, p0_q8, 2 * sizeof(prev_q8_[0]));
+    // (The start of the curve in the plane, prev_q8_[0..1], is set by next_piece().)
     // w moves linearly along the curve (a helix); without it, only u and v are walked.
     prev_q8_[2] = w0_q8_ = e.start[2] * 256;
     dw_q8_ = e.end[2] * 256 - w0_q8_;
@@ -489,12 +511,11 @@ void CurveWalker::begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind) {
     left_ = 0;
 }
 
-void CurveWalker::start_piece(Piece& g) {
+__attribute__((always_inline)) inline void CurveWalker::start_piece(Piece& g) {
     // The cubic from prev_q8_ (p0) to p3 whose control points are p0 + arm0 / 3 and
     // p3 - arm3 / 3, ticks x 256: relative to p0, c1 t + c2 t^2 + c3 t^3 with c1 = arm0,
     // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0 (in place of arm0, p3 and arm3).
-    uint8_t* z = reinterpret_cast<uint8_t*>(fd_);
-    for (uint8_t i = 0; i < sizeof(fd_); ++i) z[i] = 0;
+    memset(fd_, 0, sizeof(fd_));
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
     for (uint8_t a = 0; a < 3; ++a) {
         // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
@@ -533,13 +554,14 @@ void CurveWalker::start_piece(Piece& g) {
     }
 }
 
-void CurveWalker::arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const {
+__attribute__((always_inline)) inline void
+CurveWalker::arc_at(const int32_t dir[2], int32_t point[2], int32_t arm[2]) const {
     // X = cu + ru cos t, Y = cv + rv sin t; the arm is the tangent (-ru sin t, rv cos t) times
     // 4 tan(h/4).
+    ellipse_at(reinterpret_cast<const int32_t*>(a_.radii), dir, false, arm, point);
     for (uint8_t k = 0; k < 2; ++k) {
-        int32_t r = static_cast<int32_t>(a_.radii[k]);
-        point[k] = a_.centre[k] + mul_q30(r, dir[k]);
-        arm[k] = mul_q30(mul_q30(r, k ? dir[0] : -dir[1]), a_.arm);
+        point[k] += a_.centre[k];
+        arm[k] = mul_q30(arm[k], a_.arm);
     }
 }
 
@@ -550,18 +572,17 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     memcpy(a_.radii, radii_q8, sizeof(a_.radii));
     // Directions of the start and end points (their projections on the curve), and the sweep
     // with the extra turns, radians x 2^20 (below 2^31 for 255 turns).
-    uint32_t mag = arc_directions(e.start_q8, e.end_q8, a_.centre, a_.radii, clockwise, a_.dir);
+    uint32_t mag = arc_directions(ends_of(e), a_.centre, a_.radii, clockwise, a_.dir);
     if (mag == 0) return false; // a null radius
     mag = (mag >> 9) + turns * (kTurnQ29 >> 9);
     // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees) and kMaxPieceTicks long (sweep x
     // radius ticks).
-    uint32_t rmax = (a_.radii[0] > a_.radii[1] ? a_.radii[0] : a_.radii[1]) >> 8;
+    uint32_t rmax = larger(a_.radii) >> 8;
     // (x / 3 for x = mag / 2^17 below 2^14, by its reciprocal: a division is a library call.)
     uint32_t n = ((mag >> 17) * 21846ul >> 16) + 1u;
     uint32_t by_length = Num(mag, -20).mul(rmax + 1).div(kMaxPieceTicks).u32() + 1;
     if (by_length > n) n = by_length;
     if (n > 0xFFFF) return false;
-    piece_count_ = pieces_ = static_cast<uint16_t>(n);
     // Piece angle h, Q30 (at most 21.5 degrees, so the series apply), and 3 x the arm of its
     // cubic per unit of radius, 4 tan(h/4).
     int32_t h = static_cast<int32_t>(div_frac(mag, n, 10));
@@ -569,9 +590,7 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     rotation(h, a_.rot);
     int32_t x = h >> 2;
     a_.arm = 4 * mul_q30(x, series(2, mul_q30(x, x)));
-    int32_t p[2], arm[2];
-    arc_at(a_.dir[0], p, arm);
-    begin(e, p, 1);
+    begin(e, static_cast<uint16_t>(n), 1);
     return true;
 }
 
@@ -594,6 +613,7 @@ void CurveWalker::bezier_at(uint16_t at, int32_t point[2], int32_t arm[2]) const
 }
 
 bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2_q8[2]) {
+    save_run_to_r17();
     kind_ = 0;
     uint32_t bound = 0; // hodograph bound (power basis), ticks
     const int32_t* src[4] = {e.start_q8, p1_q8, p2_q8, e.end_q8};
@@ -602,7 +622,9 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
         int32_t d[4];
         for (uint8_t i = 0; i < 4; ++i) d[i] = (pts_[k][i] = src[i][k]) >> 8;
         differences(d);
-        uint32_t b = uabs(d[1]) + 2 * uabs(d[2]) + uabs(d[3]);
+        uint32_t b = abs32(d[2]);
+        b += b + abs32(d[1]);
+        b += abs32(d[3]);
         if (b > bound) bound = b;
     }
     bound *= 3;
@@ -615,8 +637,7 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
         n = static_cast<uint16_t>(n << 1);
     }
     log_pieces_ = j;
-    piece_count_ = pieces_ = n;
-    begin(e, e.start_q8, 2);
+    begin(e, n, 2);
     return true;
 }
 
@@ -638,18 +659,26 @@ bool CurveWalker::next_piece() {
     }
     p3[2] = w3 + w0_q8_;
     arm0[2] = arm3[2] = p3[2] - prev_q8_[2];
-    if (kind_ == 1) {
-        int32_t* dir = a_.dir[0];
-        arc_at(dir, p3, arm0);
-        rotate(dir, a_.rot);
-        if (last) memcpy(dir, a_.dir[1], sizeof(a_.dir[1])); // no drift left over
-        arc_at(dir, p3, arm3);
-    } else {
-        // Bezier part [a, a + 1/n]: the curve's ends and tangents.
-        bezier_at(index, p3, arm0); // (its point, the last piece's end, is overwritten)
-        // (At a = 1 every step of de Casteljau's algorithm gives its right point exactly: the
-        // last piece ends on the commanded end.)
-        bezier_at(static_cast<uint16_t>(index + 1), p3, arm3);
+    // The start of the piece (s = 0) and its end (s = 1): the point, overwritten at the end, and
+    // the arm. An arc's direction turns by a piece between them; a Bezier part is [a, a + 1/n].
+    int32_t* dir = a_.dir[0];
+    for (uint8_t s = 0; s < 2; ++s) {
+        static_assert(kArm0 == 0 && kArm3 == 2, "the arms at both ends");
+        int32_t* arm = g.v[2 * s];
+        // Where the piece starts (s = 0): the last one's end, computed the same way; the first
+        // piece's, the arc at its start direction, or B(0) = P0 exactly.
+        int32_t* point = s ? p3 : prev_q8_;
+        if (kind_ != 1) {
+            // (At a = 1 every step of de Casteljau's algorithm gives its right point exactly:
+            // the last piece ends on the commanded end.)
+            bezier_at(static_cast<uint16_t>(index + s), point, arm);
+        } else {
+            if (s) {
+                rotate(dir, a_.rot);
+                if (last) memcpy(dir, a_.dir[1], sizeof(a_.dir[1])); // no drift left over
+            }
+            arc_at(dir, point, arm);
+        }
     }
     start_piece(g);
     return true;
@@ -657,17 +686,12 @@ bool CurveWalker::next_piece() {
 
 bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
     save_run_from_r8();
-    if (left_ == 0) { // (a piece has at least one sample)
-        if (kind_ == 0) {
-            moved = neg = 0;
-            return false;
-        }
-        // Last step: from the rounded end of the curve to the exact target (at most one tick
-        // per axis: both are within 0.71 tick of the curve's end point).
-        if (!next_piece()) kind_ = 0;
-    }
+    // Past the last piece: the last step, from the rounded end of the curve to the exact target
+    // (at most one tick per axis: both are within 0.71 tick of the curve's end point); once made
+    // (the position is the end), no step and false.
+    if (left_ == 0 && kind_ != 0 && !next_piece()) kind_ = 0; // (a piece has a sample at least)
     const bool walking = kind_ != 0;
-    const uint8_t axes = walking ? axes_ : 3;
+    const uint8_t axes = axes_; // (w never moves on a curve of two axes: its end is its start)
     uint8_t bits = 0, down = 0, bit = 1;
     for (uint8_t a = 0; a < axes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         int32_t p = end_[a];
@@ -730,8 +754,9 @@ struct Track {
             int32_t h[3][2]; ///< B'(t) = h0 + t (h1 + t h2)
         } b;                 ///< Bezier
     };
-    Num rise; ///< |dw / dparameter|: the helix' rise
-    Num rmin; ///< Bezier: smallest radius of curvature met so far (at first 2^100: none)
+    Num rise;      ///< |dw / dparameter|: the helix' rise
+    Num rmin;      ///< Bezier: smallest radius of curvature met so far, x 2^30 (2^100: none)
+    uint32_t half; ///< |P'| / |P''| / 2 at the end of the last panel, Q29 (track_length())
 };
 
 // Shifts v[0..n-1] (n >= 1) left or right so that the largest magnitude is in [2^27, 2^28); the
@@ -827,7 +852,7 @@ inline int8_t normalise(int32_t* v, uint8_t n) {
 #else
 int8_t normalise(int32_t* v, uint8_t n) {
     uint32_t big = 0;
-    for (uint8_t i = 0; i < n; ++i) big |= uabs(v[i]); // the largest's top bit
+    for (uint8_t i = 0; i < n; ++i) big |= abs32(v[i]); // the largest's top bit
     if (big == 0) return 0;
     // big = m 2^e with m in [2^31, 2^32): its top bit is 31 + e, to be moved to bit 27.
     const int8_t sh = static_cast<int8_t>(-4 - Num(big).e);
@@ -841,14 +866,16 @@ int8_t normalise(int32_t* v, uint8_t n) {
 // P' and P'' (x 2^scale) at `off` (Q29) past the current point; with `move`, that point becomes
 // the current one.
 void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
+    save_run_to_r17();
     if (k.bezier) {
         uint32_t t = k.b.t + off;
         if (move) k.b.t = t;
         int32_t t30 = static_cast<int32_t>(t << 1);
         for (uint8_t i = 0; i < 2; ++i) {
-            int32_t q = k.b.h[1][i] + mul_q30(k.b.h[2][i], t30);
+            const int32_t a = mul_q30(k.b.h[2][i], t30);
+            const int32_t q = k.b.h[1][i] + a;
+            d2[i] = q + a;
             d1[i] = k.b.h[0][i] + mul_q30(q, t30);
-            d2[i] = q + mul_q30(k.b.h[2][i], t30);
         }
         return;
     }
@@ -861,32 +888,29 @@ void track_at(Track& k, uint32_t off, bool move, int32_t d1[2], int32_t d2[2]) {
         rotate(v, rot);
     }
     if (move) memcpy(k.e.dir[0], v, sizeof(v));
-    // (-ru sin t, rv cos t), reversed when clockwise, and (ru cos t, rv sin t) (-P'': only its
-    // size is used).
-    for (uint8_t i = 0; i < 2; ++i) {
-        int32_t a = v[1 - i];
-        if (i == k.clockwise) a = -a;
-        d1[i] = mul_q30(k.e.r[i], a);
-        d2[i] = mul_q30(k.e.r[i], v[i]);
-    }
+    // (-P'': only its size is used.)
+    ellipse_at(k.e.r, v, k.clockwise, d1, d2);
 }
 
-// |(x, y)| for signed x, y, or with `with_rise` |(x, y, rise)|.
-__attribute__((noinline)) Num norm(const int32_t v[2], const Track& k, bool with_rise) {
+// |(x, y)| for signed x, y, or with `with_rise` |(x, y, rise)|. (Inlined into probe(): its frame
+// grows by q, but the call level, deeper, goes.)
+void norm(const int32_t v[2], const Track& k, bool with_rise, Num& r) {
     Num q[3];
     components(v, k.rise, q);
-    return root_sum_squares(q, static_cast<uint8_t>(2 + with_rise));
+    root_sum_squares(q, static_cast<uint8_t>(2 + with_rise), r);
 }
 
 // The unit tangent (P', w') / |(P', w')| at the current point, Q29. Where P' = 0 (a Bezier whose
 // end arm is null), P' a little inside the curve (2^-12 of t): the direction of P''(0), or of
 // -P''(1), to 2^-12 |P'''| / |P''| rad.
 void tangent(Track& k, int32_t out[3]) {
-    int32_t d[2], d2[2];
-    track_at(k, 0, false, d, d2);
+    // P' and P'' where probe() keeps them.
+    int32_t* d = scratch<int32_t[4], kCurveProbeAt>();
+    asm("" : "+r"(d));
+    track_at(k, 0, false, d, d + 2);
     if ((d[0] | d[1]) == 0) {
         const uint32_t in = kOneQ29 >> 12; // backwards from t = 1: modulo 2^32
-        track_at(k, k.b.t ? static_cast<uint32_t>(0u - in) : in, false, d, d2);
+        track_at(k, k.b.t ? static_cast<uint32_t>(0u - in) : in, false, d, d + 2);
     }
     Num q[3];
     const uint8_t neg = components(d, k.rise, q);
@@ -894,108 +918,116 @@ void tangent(Track& k, int32_t out[3]) {
 }
 
 // The track at `off` (Q29) past its current point, which with `move` becomes the current one:
-// returns the speed sqrt(|P'|^2 + w'^2) (x 2^scale) and, with `half`, |P'| / |P''| / 2 (Q29: the
-// widest panel there). On a Bezier, the radius of curvature |P'|^3 / |P' x P''| (x 2^scale) there
+// the speed sqrt(|P'|^2 + w'^2) (x 2^scale) into `n1` (written where the caller keeps it, not
+// returned: no copies through the frames) and, with `half`, |P'| / |P''| / 2 (Q29: the widest
+// panel there). On a Bezier, the radius of curvature |P'|^3 / |P' x P''| (x 2^scale x 2^30) there
 // is kept in k.rmin when it is the smallest so far.
-Num probe(Track& k, uint32_t off, bool move, uint32_t* half) {
+void probe(Track& k, uint32_t off, bool move, uint32_t* half, Num& n1) {
     save_run_from_r8();
     // P' and P'' in the scratch RAM (scratch.h: dead there under push_line()), not in a frame
     // on the deepest stack of the firmware.
     static_assert(4 * sizeof(int32_t) <= kCurveProbeBytes, "P' and P'' fit their share");
-    int32_t(&d)[4] = scratch<int32_t[4], kCurveProbeAt>();
-    int32_t* const d1 = d;
-    int32_t* const d2 = d + 2;
+    int32_t* d1 = scratch<int32_t[4], kCurveProbeAt>();
+    asm("" : "+r"(d1)); // (reached through a pointer register: lds/sts are 4 bytes)
+    int32_t* const d2 = d1 + 2;
     track_at(k, off, move, d1, d2);
-    Num n1 = norm(d1, k, false);
+    norm(d1, k, false, n1);
     if (k.bezier) {
         // |P' x P''| / 2^30: both are below 2^30, and where the radius is smallest this keeps 20
-        // bits.
+        // bits. The radius is kept x 2^30 (below 2^90: under the 2^100 of none), and shape()
+        // takes the 2^30 off with the scale.
         int32_t cross = mul_q30(d1[0], d2[1]) - mul_q30(d1[1], d2[0]);
         if (cross != 0) {
             Num rc = n1;
-            rc.mul(n1).mul(n1).div(uabs(cross)).shift(-30);
+            rc.mul(n1).mul(n1).div(abs32(cross));
             if (rc.cmp(k.rmin) < 0) k.rmin = rc;
         }
     }
     if (half) {
-        Num n2 = norm(d2, k, false);
+        Num n2;
+        norm(d2, k, false, n2);
         *half = n2.m ? Num(n1).div(n2).shift(28).u32() : 0xFFFFFFFFul; // P'' = 0: a line
     }
-    return k.w_counts ? norm(d1, k, true) : n1;
+    if (k.w_counts) norm(d1, k, true, n1);
 }
 
-// Length of the track over `span` (Q29) from its current point, x 2^29 x 18 x 2^scale: panels
-// of 3 Gauss-Legendre nodes, each at most half the local scale |P'| / |P''| wide (so that the
-// nearest singularity of |P'| in the complex plane is at least two widths away: 1e-7 relative),
-// and at most `widest`. On a Bezier, the radii of curvature are sampled at every node and panel
-// end, and these crowd where the curve turns tightly.
-Num track_length(Track& track, uint32_t span, uint32_t widest) {
+// Adds to `total` the length of the track over `span` (Q29) from its current point, x 2^29 x 18
+// x 2^scale: panels of 3 Gauss-Legendre nodes, each at most half the local scale |P'| / |P''|
+// wide (so that the nearest singularity of |P'| in the complex plane is at least two widths
+// away: 1e-7 relative), and at most kWidestArcQ29 or kWidestBezierQ29. On a Bezier, the radii of
+// curvature are sampled at every node and panel end, and these crowd where the curve turns
+// tightly.
+void track_length(Track& track, uint32_t span, Num& total) {
     // The track's address as a pointer the callees cannot see through (it is a constant,
     // scratch.h): probe() and track_at() then reach it with displacements from a pointer
     // register (2 bytes an instruction), not at absolute addresses (lds/sts, 4 bytes).
     Track* kp = &track;
     asm("" : "+r"(kp));
     Track& k = *kp;
-    Num total{};
-    uint32_t half, w = 0;
+    uint32_t w = 0;
     for (;;) {
-        probe(k, w, true, &half); // the end of the last panel (at first, the start: w = 0)
+        Num sum, b, mid;
+        probe(k, w, true, &k.half, sum); // the end of the last panel (at first, the start)
         span -= w;
         if (span == 0) break;
-        w = half; // in a register: half's address is taken
+        w = k.half;
+        const uint32_t widest = k.bezier ? kWidestBezierQ29 : kWidestArcQ29;
         if (w > widest) w = widest;
         if (w < kNarrowestQ29) w = kNarrowestQ29;
         if (w > span) w = span;
         // Nodes at g, w / 2 and w - g, weights 5, 8, 5 (/ 18).
         const uint32_t g = static_cast<uint32_t>(mul_q30(static_cast<int32_t>(w), kGaussQ30));
-        Num sum = probe(k, g, false, nullptr);
-        sum.add(probe(k, w - g, false, nullptr)).mul(5).add(probe(k, w / 2, false, nullptr).mul(8));
+        probe(k, g, false, nullptr, sum);
+        probe(k, w - g, false, nullptr, b);
+        probe(k, w / 2, false, nullptr, mid);
+        sum.add(b).mul(5).add(mid.mul(8));
         total.add(sum.mul(w));
     }
-    return total;
 }
 
 // curve_shape() with its track passed in: the track is then reached through a pointer, not
-// through a stack frame too large for the AVR's displacement addressing.
-__attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated,
-                                     CurveShape& out, Track& k) {
+// through a stack frame too large for the AVR's displacement addressing. (Inlined into
+// curve_shape(), its one caller: one call level fewer on the deepest stack.)
+bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& out, Track& k) {
     k.w_down = dw_um < 0;
     int8_t scale;
-    uint32_t span = kOneQ29, widest = kWidestBezierQ29;
+    uint32_t span = kOneQ29;
     uint8_t turns = 0;
-    bool circle = false;
-    // The length, and |dw| (a circular helix' length is their root sum of squares).
-    Num ld[2];
-    Num& len = ld[0]; // (set below: an arc's in closed form, or by quadrature)
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
-    k.rise = ld[1].set(uabs(dw_um));
+    k.rise.set(abs32(dw_um));
     if (cp.kind == kCurveArc) {
         const uint32_t* r = reinterpret_cast<const uint32_t*>(cp.b_um);
         k.clockwise = cp.clockwise != 0;
         // The sweep in (0, 2 pi], and with the extra full turns, radians.
-        span = arc_directions(cp.start_um, cp.end_um, cp.a_um, r, k.clockwise, k.e.dir);
+        span = arc_directions(ends_of(cp), cp.a_um, r, k.clockwise, k.e.dir);
         if (span == 0) return false; // a null radius
-        widest = kWidestArcQ29;
         turns = cp.turns;
-        len.set(kTurnQ29, -29).mul(turns).add(Num(span, -29));
         // w rises linearly with the angle: dw / |sweep| per radian.
-        k.rise.div(len);
+        k.rise.div(Num(kTurnQ29, -29).mul(turns).add(Num(span, -29)));
         memcpy(k.e.r, r, sizeof(k.e.r));
         scale = normalise(k.e.r, 2);
-        const uint32_t lo = r[0] < r[1] ? r[0] : r[1];
-        const uint32_t hi = r[0] ^ r[1] ^ lo;
+        const uint32_t hi = larger(r);
+        const uint32_t lo = r[0] ^ r[1] ^ hi;
         out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
-        circle = lo == hi;
-        len.mul(lo); // a circle: r |sweep|, and a helix: sqrt(plane^2 + dw^2)
-        if (w_regulated) len = root_sum_squares(ld, 2);
     } else {
         // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
         // these fit. w rises by dw per unit of t.
         for (uint8_t i = 0; i < 2; ++i) {
-            int32_t q[4] = {cp.start_um[i], cp.a_um[i], cp.b_um[i], cp.end_um[i]};
+            // The points start, a, b, end: 0, 2, 3, 1 of the row (start end a b, as the G-code
+            // checks pin it), 2 bits each.
+            int32_t q[4];
+            const int32_t* row = cp.start_um;
+            for (uint8_t j = 0, seq = 0x78; j < 4; ++j, seq = static_cast<uint8_t>(seq >> 2)) {
+                q[j] = row[2 * (seq & 3) + i];
+            }
             differences(q);
-            for (uint8_t j = 0; j < 3; ++j) k.b.h[j][i] = (j == 1 ? 6 : 3) * q[j + 1];
+            for (uint8_t j = 0; j < 3; ++j) {
+                int32_t h = q[j + 1];
+                h += h + h; // (products are library calls)
+                if (j == 1) h += h;
+                k.b.h[j][i] = h;
+            }
         }
         scale = normalise(&k.b.h[0][0], 6);
         k.bezier = true;
@@ -1004,20 +1036,26 @@ __attribute__((noinline)) bool shape(const CurveParams& cp, int32_t dw_um, bool 
     k.rise.shift(scale);
     k.w_counts = w_regulated;
     tangent(k, out.start_dir);
-    if (!circle) { // ellipses and Beziers by quadrature
-        len = track_length(k, span, widest);
-        // An ellipse's extra turns: a full turn from wherever.
-        if (turns) len.add(track_length(k, kTurnQ29, widest).mul(turns));
-        len.div(18).shift(static_cast<int8_t>(-29 - scale));
+    // Circles too: their speed is constant, so the quadrature gives r |sweep| (and a helix'
+    // sqrt(plane^2 + dw^2)).
+    Num len{};
+    track_length(k, span, len);
+    // An arc's extra turns: a full turn from wherever.
+    if (turns) {
+        Num full{};
+        track_length(k, kTurnQ29, full);
+        len.add(full.mul(turns));
     }
+    len.div(18).shift(static_cast<int8_t>(8 - 29 - scale)); // um x 256
     if (k.bezier) {
-        out.min_radius_um = k.rmin.shift(static_cast<int8_t>(-scale)).u32(); // none: saturates
+        // (x 2^30, see probe(); none saturates)
+        out.min_radius_um = k.rmin.shift(static_cast<int8_t>(-30 - scale)).u32();
     } else {
         memcpy(k.e.dir[0], k.e.dir[1], sizeof(k.e.dir[0]));
     }
     tangent(k, out.end_dir);
     if (len.m == 0) return false;
-    out.len_q8 = len.shift(8).u32();
+    out.len_q8 = len.u32();
     return true;
 }
 

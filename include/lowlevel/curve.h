@@ -56,12 +56,13 @@ struct CurveShape {
 
 /// Length, curvature and end tangents of a curve whose normal axis travels `dw_um`
 /// (`w_regulated`: w counts in the path length). Returns false for a degenerate curve.
-/// Circles and circular helices in closed form. Ellipses and Beziers (and their helices) by
-/// Gauss-Legendre quadrature of the speed, 3 nodes per panel, each panel at most half the local
-/// scale |P'| / |P''| wide: panels shrink where the curve turns tightly (the ends of an
-/// eccentric ellipse's major axis, near-cusps), so the length is good to 1e-6 relative
-/// (docs/curves.md: no closed form exists for an ellipse). The smallest radius of curvature of a
-/// Bezier is the smallest |B'|^3 / |B' x B''| at the panel ends, which crowd where it is small.
+/// All curves (circles too: no closed-form special case, their constant speed makes the
+/// quadrature exact to 1e-7) by Gauss-Legendre quadrature of the speed, 3 nodes per panel, each
+/// panel at most half the local scale |P'| / |P''| wide: panels shrink where the curve turns
+/// tightly (the ends of an eccentric ellipse's major axis, near-cusps), so the length is good to
+/// 1e-6 relative (docs/curves.md: no closed form exists for an ellipse). The smallest radius of
+/// curvature of a Bezier is the smallest |B'|^3 / |B' x B''| at the panel ends, which crowd where
+/// it is small.
 bool curve_shape(const CurveParams& c, int32_t dw_um, bool w_regulated, CurveShape& out);
 
 /// Direction of the point (x, y) seen from an ellipse's centre, normalised in the ellipse's
@@ -109,7 +110,7 @@ class CurveWalker {
     int32_t pos[3]; ///< current position, ticks (u, v, w)
 
   private:
-    void begin(const Ends& e, const int32_t p0_q8[2], uint8_t kind);
+    void begin(const Ends& e, uint16_t pieces, uint8_t kind);
     bool next_piece();
     /// A piece: 3 x its arm at the start, its end and 3 x its arm at the end, ticks x 256 (u, v,
     /// w); start_piece() turns the three into the cubic's coefficients c1, c2, c3 in place.
