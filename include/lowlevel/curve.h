@@ -56,13 +56,12 @@ struct CurveShape {
 
 /// Length, curvature and end tangents of a curve whose normal axis travels `dw_um`
 /// (`w_regulated`: w counts in the path length). Returns false for a degenerate curve.
-/// All curves (circles too: no closed-form special case, their constant speed makes the
-/// quadrature exact to 1e-7) by Gauss-Legendre quadrature of the speed, 3 nodes per panel, each
-/// panel at most half the local scale |P'| / |P''| wide: panels shrink where the curve turns
-/// tightly (the ends of an eccentric ellipse's major axis, near-cusps), so the length is good to
-/// 1e-6 relative (docs/curves.md: no closed form exists for an ellipse). The smallest radius of
-/// curvature of a Bezier is the smallest |B'|^3 / |B' x B''| at the panel ends, which crowd where
-/// it is small.
+/// Circles and circular helices in closed form. Ellipses and Beziers (and their helices) by
+/// Gauss-Legendre quadrature of the speed, 3 nodes per panel, each panel at most half the local
+/// scale |P'| / |P''| wide: panels shrink where the curve turns tightly (the ends of an
+/// eccentric ellipse's major axis, near-cusps), so the length is good to 1e-6 relative
+/// (docs/curves.md: no closed form exists for an ellipse). The smallest radius of curvature of a
+/// Bezier is the smallest |B'|^3 / |B' x B''| at the panel ends, which crowd where it is small.
 bool curve_shape(const CurveParams& c, int32_t dw_um, bool w_regulated, CurveShape& out);
 
 /// Direction of the point (x, y) seen from an ellipse's centre, normalised in the ellipse's
