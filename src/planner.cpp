@@ -34,6 +34,31 @@ constexpr int8_t k3_6e = -30;
 constexpr uint32_t kMilli = 0x83126E97ul; // 1/1000 = kMilli * 2^-41 (1/128000: 2^-48)
 constexpr uint32_t kMicro = 0x8637BD05ul; // 1e-6 = kMicro * 2^-51 (5e-7: 2^-52)
 
+// n1 / d1 < n2 / d2, exactly (64-bit products).
+bool ratio_less(uint32_t n1, uint32_t d1, uint32_t n2, uint32_t d2) {
+    if (n1 == n2) return d1 > d2;
+    uint32_t l1, h1 = mul_wide(n1, d2, l1);
+    uint32_t l2, h2 = mul_wide(n2, d1, l2);
+    return h1 != h2 ? h1 < h2 : l1 < l2;
+}
+
+// The axis with comp[a] > 0 whose lim[a] / comp[a] is the smallest (the first one on a tie),
+// kAxes when every comp[a] is 0.
+uint8_t tightest(const AxisSettings* ax, Limit which, const uint32_t comp[kAxes]) {
+    uint8_t best = kAxes;
+    uint32_t best_lim = 0, best_comp = 0;
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        const uint32_t c = comp[a], lim = ax[a].*which;
+        if (c == 0) continue;
+        if (best == kAxes || ratio_less(lim, c, best_lim, best_comp)) {
+            best = a;
+            best_lim = lim;
+            best_comp = c;
+        }
+    }
+    return best;
+}
+
 // x <= 5e-7 (GRBL's junction thresholds): 5e-7 = kMicro 2^-52. A zero (exponent 0) is not
 // caught here: junction2()'s q has its exponent lowered by 60 first (a zero q is tiny), and a
 // zero p = 1 - q comes out as a junction speed of 0 from the exact formula, as from tiny().
@@ -96,15 +121,24 @@ void place(int32_t out[kAxes], const int32_t dir[3], uint8_t plane, uint8_t n) {
 void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out) {
     uint32_t x[kAxes];
     out.len_q8 = travel(m, delta, group, x);
-    // limit_along() for the rate and the acceleration: the smallest over the moving axes of
-    // limit x len / x[a], the rate and the acceleration from one quotient per axis.
+    // limit_along() for the rate, then the acceleration, sharing len / x[a] when one axis bounds
+    // both (the common case): one division.
     const AxisSettings* ax = m.settings->axis;
-    out.vmax = out.accel = 0xFFFFFFFFul; // nothing moves
-    for (uint8_t a = 0; a < kAxes; ++a, ++ax) {
-        if (x[a] == 0) continue;
-        Num r(out.len_q8);
-        lower(out.vmax, r.div(x[a]).of(ax->max_rate));
-        lower(out.accel, r.mulc(k3_6, k3_6e).of(ax->accel)); // units/s^2 x1000 -> units/min^2
+    Num r;
+    uint8_t prev = kAxes;
+    static_assert(offsetof(MoveLimits, accel) == offsetof(MoveLimits, vmax) + 4, "in order");
+    uint32_t* o = &out.vmax; // then out.accel
+    for (uint8_t k = 0; k < 2; ++k, ++o) {
+        const Limit which = k ? kAccel : kRate;
+        const uint8_t a = tightest(ax, which, x);
+        uint32_t v = 0xFFFFFFFFul; // nothing moves
+        if (a != kAxes) {
+            if (a != prev) r.set(out.len_q8).div(x[a]);
+            prev = a;
+            if (k) r.mulc(k3_6, k3_6e); // units/s^2 x1000 -> units/min^2
+            v = at_least_1(r.of(ax[a].*which));
+        }
+        *o = v;
     }
 }
 
@@ -182,6 +216,7 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     // limit_value_by_axis_maximum): min over the axes of d of accel[a] |d| / d[a] (units/s^2
     // x1000 -> units/min^2: x 3.6), at least 1; |d| in Q29: sqrt(q) * 2 * 2^29. delta in µm /
     // 1000.
+    // (A quotient per axis of d: this exact path is rare in chains of short segments.)
     const AxisSettings* ax = m.settings->axis;
     q.sqrt().mulc(k3_6, -16); // sqrt(q) 2^16 x 2^14 = |d| in Q29, x 3.6 (k3_6 2^-30)
     uint32_t acc = 0xFFFFFFFFul;

@@ -43,7 +43,7 @@ struct PlanBlock {
 struct MoveLimits {
     uint32_t len_q8; ///< µm x 256
     uint32_t vmax;   ///< units/min x1000
-    uint32_t accel;  ///< units/min^2
+    uint32_t accel;  ///< units/min^2 (after vmax: move_limits() writes them in this order)
 };
 void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, MoveLimits& out);
 
