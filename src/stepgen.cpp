@@ -431,7 +431,7 @@ uint32_t StepGen::delta_at(uint32_t x2) {
         changed = root_.seek(a);
     }
     if (changed) {
-        delta_root_ = div32_16(prof_.d_num, static_cast<uint16_t>(root_.r != 0 ? root_.r : 1));
+        delta_root_ = div32_16(prof_.d_num, root_.r != 0 ? root_.r : 1);
 #if LL_STATS
         ++stats.divisions;
 #endif
