@@ -54,8 +54,8 @@ void StepGen::configure(const StepLengths* lengths, uint16_t min_period,
 bool StepGen::begin(const MoveSpec& spec) {
     pushed_position(start_); // the previous move is complete: start from its end
     curve_ = nullptr;
-    if (spec.curve) return begin_curve(spec);
-    return begin_line(spec);
+    if (!(spec.curve ? begin_curve(spec) : begin_line(spec))) return false;
+    return start_profile(spec);
 }
 
 bool StepGen::begin_line(const MoveSpec& spec) {
@@ -63,7 +63,7 @@ bool StepGen::begin_line(const MoveSpec& spec) {
     line_start(ln_.g, ln_.c);
     build_k_table(spec.group);
     ln_.k_err = 0;
-    return start_profile(spec);
+    return true;
 }
 
 inline void StepGen::take_spec(const MoveSpec& spec) {
@@ -84,7 +84,7 @@ bool StepGen::start_profile(const MoveSpec& spec) {
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
-    prepare_profile(entry, spec.v_exit2);
+    prepare_profile(entry);
     // (read only while holding: a hold begun later sets them again)
     a_hold_ = prof_.a_entry;
     x2_hold_ = 0;
@@ -215,10 +215,10 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     cv_.ref_um = ref_um;
     cv_.x_q8 = 0;
     cv_.chord_left = 0; // no chord yet (fill_curve)
-    return start_profile(spec);
+    return true;
 }
 
-void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2) {
+void StepGen::prepare_profile(uint32_t v_entry2) {
     const uint32_t d1 = ref_len();
     const uint32_t remaining_ticks = d1 - origin_;
     // From psi = 1 / (dv2 d_1), one division (dv2 = 2 a L, a = 128000 dv2 / len_q8):
@@ -237,7 +237,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2) {
     dn.sqrt().mul(len_q8_).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
-    uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);
+    uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2_)), remaining_ticks);
     // D 2^m = dn.m 2^(dn.e + m) is below 2^32 - 1 while dn.e + m <= e_lim (D = 0: always).
     int8_t e_lim = dn.m == 0xFFFFFFFFul ? -1 : 0;
     if (dn.m == 0) e_lim = 127;
@@ -250,7 +250,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2) {
     prof_.d = remaining_ticks;
     prof_.a_cruise = a_of(v_nominal2_);
     prof_.a_entry = a_of(v_entry2);
-    set_a_exit(a_of(v_exit2));
+    set_a_exit();
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
     prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(t.set(feed_).mul(d1)).u32();
@@ -271,7 +271,8 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2) {
     }
 }
 
-void StepGen::set_a_exit(uint32_t a) {
+void StepGen::set_a_exit() {
+    const uint32_t a = a_of(v_exit2_);
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
     // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
     // A_cruise everywhere (delta_at() skips it) and the end deceleration starts at its end
@@ -285,7 +286,7 @@ void StepGen::set_exit(uint32_t v_exit2) {
     if (v_exit2 == v_exit2_) return;   // called at every poll: usually no change
     if (x2_now() >= x2_decel_) return; // end deceleration already begun
     v_exit2_ = v_exit2;
-    set_a_exit(a_of(v_exit2));
+    set_a_exit();
 }
 
 void StepGen::hold() {
@@ -301,7 +302,7 @@ void StepGen::resume(uint32_t v_exit2) {
     if (!stopped_) return;
     v_exit2_ = v_exit2;
     origin_ = progress();
-    prepare_profile(0, v_exit2);
+    prepare_profile(0);
 }
 
 uint32_t StepGen::speed2() const {

@@ -142,18 +142,19 @@ class StepGen {
     /// A line's part of begin() (out of line: begin()'s frame, under begin_curve(), stays
     /// small).
     bool begin_line(const MoveSpec& spec);
-    /// The profile from origin_ (set first) to the move's end; also clears stopped_ and makes
-    /// the first segment one tick.
-    void prepare_profile(uint32_t v_entry2, uint32_t v_exit2);
+    /// The profile from origin_ (set first) to the move's end, from `v_entry2` to v_exit2_; also
+    /// clears stopped_ and makes the first segment one tick.
+    void prepare_profile(uint32_t v_entry2);
     void take_spec(const MoveSpec& spec);
-    /// What begin() and begin_curve() share: the speeds and the profile over the whole move.
+    /// What begin() does after begin_line() or begin_curve(): the speeds and the profile over the
+    /// whole move (one call for both; out of line: begin()'s frame, under begin_curve(), stays
+    /// small).
     bool start_profile(const MoveSpec& spec);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
-    /// Sets prof_.a_exit to `a` (a_of() of the exit speed; at most A_cruise), then x2_decel_
-    /// and cruising_ from prof_. It calls nothing deep: profile_x2_decel() is inlined in it, and
-    /// the callers take a_of() with their own frames.
-    void set_a_exit(uint32_t a);
+    /// Sets prof_.a_exit to a_of(v_exit2_) (at most A_cruise), then x2_decel_ and cruising_
+    /// from prof_. It calls nothing deep: a_of(), and profile_x2_decel() is inlined in it.
+    void set_a_exit();
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
     /// queued_cycles(q) >= kHorizonCycles.
     bool horizon_full(const RunQueue& q);
