@@ -88,15 +88,16 @@ inline bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
 
 /// Macro position along a line (seed §2.1), in ticks travelled per sorted position.
 struct LineCursor {
-    uint32_t x1;          ///< reference-axis ticks travelled
-    uint32_t pos[kAxes];  ///< ticks travelled at each sorted position
+    union {
+        uint32_t x1;         ///< reference-axis ticks travelled (pos[0]: one counter, not two)
+        uint32_t pos[kAxes]; ///< ticks travelled at each sorted position
+    };
     uint32_t frac[kAxes]; ///< fractional part of S_j * x_1 + P/2, k bits, in kLineUnit units
 };
 
 /// (Inline: StepGen::begin() takes it without a call.)
 inline void line_start(const LineGeometry& g, LineCursor& c) {
-    c.x1 = 0;
-    uint32_t* pos = c.pos;
+    uint32_t* pos = c.pos; // (x1 is pos[0])
     uint32_t* frac = c.frac;
     for (uint8_t j = g.m; j; --j) {
         *pos++ = 0;
