@@ -274,10 +274,6 @@ void StepGen::prepare_profile(uint32_t v_entry2) {
 void StepGen::set_a_exit() {
     const uint32_t a = a_of(v_exit2_);
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
-    // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
-    // A_cruise everywhere (delta_at() skips it) and the end deceleration starts at its end
-    // (what profile_x2_decel gives then). Chains of short moves are made of such moves.
-    cruising_ = prof_.a_entry == prof_.a_cruise && prof_.a_exit == prof_.a_cruise;
     x2_decel_ = profile_x2_decel(prof_);
 }
 
@@ -320,8 +316,11 @@ void StepGen::pushed_position(int32_t out[kAxes]) const {
     const uint8_t dirs = ln_.g.dirs;
     for (uint8_t j = ln_.g.m; j; --j) {
         uint8_t a = *axis++;
-        int32_t p = static_cast<int32_t>(*pos++);
-        out[a] += ((dirs >> a) & 1) ? -p : p;
+        uint32_t p = *pos++;
+        uint8_t d = dirs;
+        for (uint8_t i = a; i; --i) d = static_cast<uint8_t>(d >> 1);
+        if (d & 1) p = 0u - p;
+        out[a] = static_cast<int32_t>(static_cast<uint32_t>(out[a]) + p);
     }
 }
 
@@ -407,10 +406,9 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
 }
 
 uint32_t StepGen::delta_at(uint32_t x2) {
-    if (cruising_ && !holding_) {
-        a_last_ = prof_.a_cruise; // profile_a(x2) == a_cruise: no evaluation
-        return prof_.cruise;
-    }
+    // (A move that enters and leaves at cruise speed, as in chains of short moves, is at
+    // A_cruise everywhere and takes the shortcut below after profile_a(): a separate test of
+    // such moves before it saved its 370 cycles a segment but cost 70 B.)
     x2 -= 2 * origin_;
     uint32_t a = profile_a(prof_, x2);
     if (holding_) {

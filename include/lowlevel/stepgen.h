@@ -152,8 +152,8 @@ class StepGen {
     bool start_profile(const MoveSpec& spec);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
-    /// Sets prof_.a_exit to a_of(v_exit2_) (at most A_cruise), then x2_decel_ and cruising_
-    /// from prof_. It calls nothing deep: a_of(), and profile_x2_decel() is inlined in it.
+    /// Sets prof_.a_exit to a_of(v_exit2_) (at most A_cruise), then x2_decel_ from prof_. It calls
+    /// nothing deep: a_of(), and profile_x2_decel() is inlined in it.
     void set_a_exit();
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
     /// queued_cycles(q) >= kHorizonCycles.
@@ -191,7 +191,6 @@ class StepGen {
     bool have_handover_;
     bool root_valid_;
     bool lens_valid_; ///< ln_.lens holds step lengths (no curve ran since, same settings)
-    bool cruising_;   ///< the profile is at cruise from end to end (set_a_exit())
     uint8_t seg_len_;
     uint8_t seen_head_;
     uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
