@@ -274,13 +274,14 @@ void StepGen::prepare_profile(uint32_t v_entry2) {
 void StepGen::set_a_exit() {
     const uint32_t a = a_of(v_exit2_);
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
-    x2_decel_ = profile_x2_decel(prof_);
 }
 
 void StepGen::set_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
-    if (v_exit2 == v_exit2_) return;   // called at every poll: usually no change
-    if (x2_now() >= x2_decel_) return; // end deceleration already begun
+    if (v_exit2 == v_exit2_) return; // called at every poll: usually no change
+    // end deceleration already begun (the point from the profile in force: set_exit() is the
+    // only reader, and its test is rarely reached)
+    if (x2_now() >= profile_x2_decel(prof_)) return;
     v_exit2_ = v_exit2;
     set_a_exit();
 }

@@ -152,8 +152,7 @@ class StepGen {
     bool start_profile(const MoveSpec& spec);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
-    /// Sets prof_.a_exit to a_of(v_exit2_) (at most A_cruise), then x2_decel_ from prof_. It calls
-    /// nothing deep: a_of(), and profile_x2_decel() is inlined in it.
+    /// Sets prof_.a_exit to a_of(v_exit2_), at most A_cruise.
     void set_a_exit();
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
     /// queued_cycles(q) >= kHorizonCycles.
@@ -203,12 +202,13 @@ class StepGen {
     // What remains needed of the MoveSpec after begin() (in MoveSpec's order: take_spec() copies
     // them as one block).
     uint32_t v_nominal2_, v_exit2_, len_q8_;
-    // Only a started move uses these four: begin_curve() borrows their room for the curve's
-    // commanded points (its frame then stays below the 64 bytes the ATmega addresses directly).
+    // Only a started move uses these four (take_spec() sets feed_ after begin_curve()):
+    // begin_curve() borrows their room for the curve's commanded points (its frame then stays
+    // below the 64 bytes the ATmega addresses directly).
     union {
         struct {
             uint32_t delta_root_; ///< d_num / R for the current R
-            uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
+            uint32_t feed_;       ///< nominal speed, mm/min x 1000 (MoveSpec)
             // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
             uint32_t a_hold_;
             uint32_t x2_hold_;
@@ -217,9 +217,8 @@ class StepGen {
                                   ///< control points, ticks x 256
     };
     uint32_t handover_v2_;
-    Num a_per_v2_;  ///< A per (mm/min)^2 at the profile's scale
-    uint32_t feed_; ///< nominal speed, mm/min x 1000 (MoveSpec)
-    Num dv2_;       ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
+    Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
+    Num dv2_;      ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     struct LineState {
         uint32_t kmax; ///< largest K of the move
         int32_t k_err; ///< K-time emitted beyond len x Delta_1 so far, Q20 (see fill_line)
