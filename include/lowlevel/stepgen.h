@@ -179,8 +179,13 @@ class StepGen {
     uint32_t x2_now() const;
 
     // Most used first: the ATmega328P addresses the first 64 bytes of an object directly (the
-    // order was measured: image size, and llsegcost's cycles per segment for what delta_at()
-    // reads on every segment).
+    // order was measured: image size, by a greedy search over the order of these groups, and
+    // llsegcost's cycles per segment for what delta_at() reads on every segment).
+    // What remains needed of the MoveSpec after begin() (in MoveSpec's order: take_spec() copies
+    // them as one block).
+    uint32_t v_nominal2_, v_exit2_, len_q8_;
+    uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
+    uint16_t min_period_;
     Profile prof_;
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
@@ -192,16 +197,12 @@ class StepGen {
     bool lens_valid_; ///< ln_.lens holds step lengths (no curve ran since, same settings)
     uint8_t seg_len_;
     uint8_t seen_head_;
-    uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
-    uint16_t min_period_;
+    uint32_t a_last_; ///< A of the last segment
     // The move being produced: a line or a curve, never both, so they share their memory.
     const CurveParams* curve_;
     uint32_t origin_; ///< reference tick where the profile starts (moves after a resume)
-    uint32_t a_last_; ///< A of the last segment
+    uint32_t handover_v2_;
     SqrtTracker root_;
-    // What remains needed of the MoveSpec after begin() (in MoveSpec's order: take_spec() copies
-    // them as one block).
-    uint32_t v_nominal2_, v_exit2_, len_q8_;
     // Only a started move uses these four (take_spec() sets feed_ after begin_curve()):
     // begin_curve() borrows their room for the curve's commanded points (its frame then stays
     // below the 64 bytes the ATmega addresses directly).
@@ -216,7 +217,6 @@ class StepGen {
         int32_t curve_pts_[2][2]; ///< begin_curve(): arc centre and semi-axes, or the Bezier's
                                   ///< control points, ticks x 256
     };
-    uint32_t handover_v2_;
     Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
     Num dv2_;      ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     struct LineState {
