@@ -116,17 +116,24 @@ __attribute__((always_inline)) inline void StepGen::build_k_table(uint8_t group)
     //   K[P] = L_P * count_g / sum_g  (Q20), and 1 for a run without a regulated axis.
     // The step lengths (one square root each) depend on the axis sets only: kept from the
     // previous line (consecutive lines mostly move the same axes in the same order).
+    // Every entry is forgotten when the lengths are not valid (a curve's state overwrote them,
+    // or the settings changed), not only the first `sets`: a later line with more axes would
+    // otherwise read entries that a curve left, where a stale byte can look like its set. 0xFF
+    // is no set (mask < 2^kAxes).
+    if (!lens_valid_) {
+        for (uint8_t& set : ln_.lens_set) set = 0xFF;
+    }
+    lens_valid_ = true;
     uint32_t* lens = ln_.lens;
     uint32_t sum_hi, sum_lo, count_g;
     for (;;) {
         for (uint8_t sub = 0; sub < sets; ++sub) {
             uint8_t set = static_cast<uint8_t>(ln_.mask[sub] & group);
-            if (!lens_valid_ || ln_.lens_set[sub] != set) {
+            if (ln_.lens_set[sub] != set) {
                 ln_.lens_set[sub] = set;
                 lens[sub] = step_length(*lengths_, set);
             }
         }
-        lens_valid_ = true;
         // sum_g exact in two halves (n < 2^23, len < 2^32, m <= 6 terms): mul_wide() and a carry
         // are smaller than avr-gcc 5.4's uint64_t (__umulsidi3, __adddi3, __lshrdi3 and the moves)
         sum_hi = sum_lo = count_g = 0;

@@ -227,7 +227,7 @@ class StepGen {
         uint32_t k[1u << (kAxes - 1)];   ///< K table, Q20 (see k())
         uint8_t mask[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
         // Step length of each sorted set (restricted to the regulated group), kept from one
-        // line to the next while lens_valid_: in the room the curve state leaves.
+        // line to the next while lens_valid_ (build_k_table()): in the room the curve state leaves.
         uint32_t lens[1u << (kAxes - 1)];
         uint8_t lens_set[1u << (kAxes - 1)];       ///< the axis set each length is for
         uint32_t cruise_period[1u << (kAxes - 1)]; ///< K * Delta_1 at cruise, cycles x 256
