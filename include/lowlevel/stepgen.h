@@ -222,14 +222,14 @@ class StepGen {
     struct LineState {
         uint32_t kmax; ///< largest K of the move
         int32_t k_err; ///< K-time emitted beyond len x Delta_1 so far, Q20 (see fill_line)
-        LineGeometry g;
         LineCursor c;
-        uint32_t k[1u << (kAxes - 1)];   ///< K table, Q20 (see k())
+        LineGeometry g;
         uint8_t mask[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
         // Step length of each sorted set (restricted to the regulated group), kept from one
         // line to the next while lens_valid_ (build_k_table()): in the room the curve state leaves.
         uint32_t lens[1u << (kAxes - 1)];
         uint8_t lens_set[1u << (kAxes - 1)];       ///< the axis set each length is for
+        uint32_t k[1u << (kAxes - 1)];             ///< K table, Q20 (see k())
         uint32_t cruise_period[1u << (kAxes - 1)]; ///< K * Delta_1 at cruise, cycles x 256
         uint8_t cruise_seg;                        ///< segment length at cruise
     };
