@@ -314,7 +314,7 @@ uint32_t StepGen::speed2() const {
 }
 
 void StepGen::pushed_position(int32_t out[kAxes]) const {
-    for (uint8_t a = 0; a < kAxes; ++a) out[a] = start_[a];
+    memcpy(out, start_, sizeof(start_));
     if (curve_) {
         for (uint8_t k = 0; k < 3; ++k) out[cv_.axes[k]] = cv_.w.pos[k];
         return;
@@ -333,7 +333,7 @@ void StepGen::pushed_position(int32_t out[kAxes]) const {
 }
 
 void StepGen::set_position(const int32_t steps[kAxes]) {
-    for (uint8_t a = 0; a < kAxes; ++a) start_[a] = steps[a];
+    memcpy(start_, steps, sizeof(start_));
     ln_.g.m = 0;
     curve_ = nullptr;
     active_ = false;
