@@ -11,8 +11,6 @@ void machine_build(Machine& m, const Settings& s) {
         const uint32_t spm = spu < 1000 ? 1000 : spu; // T >= 1 step per unit
         m.um_q8_per_step[a].set(256000000ul).div(spm);
         step_length_inv2(m.lengths.inv2[a], spm); // (step_lengths_build(), in this loop)
-    }
-    for (uint8_t a = 0; a < kAxes; ++a) {
         uint8_t mask = 0, bit = 1;
         for (uint8_t b = 0; b < kAxes; ++b, bit = static_cast<uint8_t>(bit << 1)) {
             if (s.axis_group[b] == s.axis_group[a]) mask = static_cast<uint8_t>(mask | bit);
