@@ -53,7 +53,7 @@ inline bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         int32_t d = delta[a];
         if (d == 0) continue;
-        uint32_t dist = d < 0 ? static_cast<uint32_t>(-(d + 1)) + 1u : static_cast<uint32_t>(d);
+        uint32_t dist = abs32(d);
         if (d < 0) g.dirs = static_cast<uint8_t>(g.dirs | bit);
         uint8_t i = g.m;
         while (i > 0 && g.dist[i - 1] < dist) {
