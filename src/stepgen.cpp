@@ -54,7 +54,12 @@ void StepGen::configure(const StepLengths* lengths, uint16_t min_period,
 bool StepGen::begin(const MoveSpec& spec) {
     pushed_position(start_); // the previous move is complete: start from its end
     curve_ = nullptr;
-    if (!(spec.curve ? begin_curve(spec) : begin_line(spec))) return false;
+    if (!(spec.curve ? begin_curve(spec) : begin_line(spec))) {
+        // Refused: nothing of it moves (begin_curve() may have written over the line state, or
+        // left the last line's in place).
+        ln_.g.m = 0;
+        return false;
+    }
     return start_profile(spec);
 }
 
@@ -175,7 +180,6 @@ uint32_t StepGen::a_of(uint32_t v2) const {
 bool StepGen::begin_curve(const MoveSpec& spec) {
     const CurveParams& c = *spec.curve;
     if (!um_q8_per_step_) return false;
-    ln_.g.m = 0;
     lens_valid_ = false; // the curve's state overwrites the lines
     // plane_axes(): (u, v, w) = (X, Y, Z), (Z, X, Y), (Y, Z, X), i.e. axis (k - plane) mod 3.
     for (uint8_t k = 0, a = static_cast<uint8_t>(3 - c.plane); k < 3; ++k, ++a) {
