@@ -595,31 +595,32 @@ void StepGen::fill_curve(RunQueue& q) {
         if (stopped_) break;
         // Delta (cycles x 256 per µm) x chord (µm x 256) / 256.
         uint32_t period_q8 = mul_shr(delta, chord_q8, 8);
-        // Samples of the same axes and directions make one run.
+        // Samples of the same axes and directions make one run (compared as the walker gives
+        // them: the rotation below is one to one).
         // (u, v, w) bits to machine-axis bits: axis (k - plane) mod 3 (begin_curve) is a
-        // rotation of the three bits by plane = 2 - axes[2] to the right.
+        // rotation of the three bits by plane = 2 - axes[2] to the right, once per run.
         const uint8_t plane = static_cast<uint8_t>(2 - cv_.axes[2]);
-        uint8_t run_steps = 0, run_dirs = 0, run_count = 0;
+        uint8_t run_moved = 0, run_neg = 0, run_count = 0;
         // One emit() for both ends of a run: a sample that differs, or none left.
         uint8_t i = 0;
         for (;; ++i) {
             uint8_t moved = 0, neg = 0;
             const bool more = i < n && cv_.w.next(moved, neg);
-            uint8_t steps = static_cast<uint8_t>(moved * 9u), dirs = static_cast<uint8_t>(neg * 9u);
-            for (uint8_t p = plane; p; --p) {
-                steps = static_cast<uint8_t>(steps >> 1);
-                dirs = static_cast<uint8_t>(dirs >> 1);
-            }
-            steps &= 7;
-            dirs &= 7;
-            if (run_count != 0 && (!more || steps != run_steps || (steps && dirs != run_dirs))) {
-                emit(q, run_steps, run_dirs, run_count, period_q8);
+            if (run_count != 0 && (!more || moved != run_moved || (moved && neg != run_neg))) {
+                uint8_t steps = static_cast<uint8_t>(run_moved * 9u);
+                uint8_t dirs = static_cast<uint8_t>(run_neg * 9u);
+                for (uint8_t p = plane; p; --p) {
+                    steps = static_cast<uint8_t>(steps >> 1);
+                    dirs = static_cast<uint8_t>(dirs >> 1);
+                }
+                emit(q, static_cast<uint8_t>(steps & 7), static_cast<uint8_t>(dirs & 7), run_count,
+                     period_q8);
                 run_count = 0;
             }
             if (!more) break;
             if (run_count == 0) {
-                run_steps = steps;
-                run_dirs = steps ? dirs : run_dirs;
+                run_moved = moved;
+                run_neg = moved ? neg : run_neg;
             }
             ++run_count;
         }
