@@ -5,8 +5,7 @@
 namespace ll {
 
 void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[kAxes]) {
-    c.x1 += len;
-    c.pos[0] += len;
+    c.pos[0] += len; // (x1 too)
     e[0] = len;
     // The last segment needs no special case: S_j * d_1 + P/2 lands within 1/16 tick of
     // d_j + 1/2 by construction (|d_1 (S_j / P - s_j)| <= d_1 / (2P) <= 1/16), so the sum of the

@@ -3,40 +3,23 @@
 namespace ll {
 
 uint8_t micro_split(const uint8_t e[], uint8_t m, MicroRun out[]) {
-    // Sorted positions 1..m-1 with a non-zero increment, ordered by increment, increasing.
-    uint8_t order[kAxes];
-    uint8_t n = 0;
-    uint8_t set = 1;
-    uint8_t bit = 1;
-    for (uint8_t j = 1; j < m; ++j) {
-        bit = static_cast<uint8_t>(bit << 1); // 1 << j
-        if (e[j] == 0) continue;
-        set = static_cast<uint8_t>(set | bit);
-        uint8_t i = n;
-        while (i > 0 && e[order[i - 1]] > e[j]) {
-            order[i] = order[i - 1];
-            --i;
-        }
-        order[i] = j;
-        ++n;
-    }
+    // Each run takes every axis with steps left and ends at the smallest increment still ahead
+    // (where the axes that reach it drop out); the last one ends at e[0].
     MicroRun* o = out;
     uint8_t done = 0; // micro steps emitted so far
-    for (uint8_t i = 0; i < n; ++i) {
-        uint8_t j = order[i];
-        if (e[j] > done) {
-            o->set = set;
-            o->count = static_cast<uint8_t>(e[j] - done);
-            ++o;
-            done = e[j];
+    do {
+        uint8_t next = e[0], set = 0, bit = 1;
+        for (uint8_t j = 0; j < m; ++j, bit = static_cast<uint8_t>(bit << 1)) {
+            if (e[j] > done) {
+                set = static_cast<uint8_t>(set | bit);
+                if (e[j] < next) next = e[j];
+            }
         }
-        set = static_cast<uint8_t>(set & ~(1u << j)); // axis j has reached its target
-    }
-    if (e[0] > done) {
         o->set = set;
-        o->count = static_cast<uint8_t>(e[0] - done);
+        o->count = static_cast<uint8_t>(next - done);
         ++o;
-    }
+        done = next;
+    } while (done != e[0]);
     return static_cast<uint8_t>(o - out);
 }
 

@@ -27,22 +27,24 @@ uint32_t profile_a(const Profile& p, uint32_t x2) {
 
 void SqrtTracker::reset(uint32_t a) {
     r = isqrt32(a);
-    c = r * r;
+    c = static_cast<uint32_t>(r) * r;
 }
 
 bool SqrtTracker::seek(uint32_t a) {
-    uint32_t before = r;
+    const uint16_t before = r;
     // A few steps of R per macro segment; a long way (a new move, a feed hold) is a jump, where
     // one full square root is cheaper than walking: beyond 64 (R + 1) of A.
-    uint32_t far = ((r + 1) << 8) >> 2; // byte move and two shifts, not a 6-turn loop
-    if ((a > c ? a - c : c - a) > far) {
+    uint32_t far = ((before + 1ul) << 8) >> 2; // byte move and two shifts, not a 6-turn loop
+    uint32_t cc = c;
+    if ((a > cc ? a - cc : cc - a) > far) {
         reset(a);
     } else {
-        for (uint32_t step = 2 * r + 1; a >= c + step; step += 2) { // (R + 1)^2 = R^2 + 2 R + 1
-            c += step;
-            ++r;
-        }
-        while (a < c) c -= 2 * --r + 1;
+        // Walked in registers on step = 2 R + 1 = (R + 1)^2 - R^2 alone, R = step / 2.
+        uint32_t step = 2ul * before + 1;
+        for (; a >= cc + step; step += 2) cc += step;
+        while (a < cc) cc -= step -= 2;
+        r = static_cast<uint16_t>(step >> 1);
+        c = cc;
     }
     return r != before;
 }

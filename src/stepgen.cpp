@@ -54,8 +54,13 @@ void StepGen::configure(const StepLengths* lengths, uint16_t min_period,
 bool StepGen::begin(const MoveSpec& spec) {
     pushed_position(start_); // the previous move is complete: start from its end
     curve_ = nullptr;
-    if (spec.curve) return begin_curve(spec);
-    return begin_line(spec);
+    if (!(spec.curve ? begin_curve(spec) : begin_line(spec))) {
+        // Refused: nothing of it moves (begin_curve() may have written over the line state, or
+        // left the last line's in place).
+        ln_.g.m = 0;
+        return false;
+    }
+    return start_profile(spec);
 }
 
 bool StepGen::begin_line(const MoveSpec& spec) {
@@ -63,7 +68,7 @@ bool StepGen::begin_line(const MoveSpec& spec) {
     line_start(ln_.g, ln_.c);
     build_k_table(spec.group);
     ln_.k_err = 0;
-    return start_profile(spec);
+    return true;
 }
 
 inline void StepGen::take_spec(const MoveSpec& spec) {
@@ -84,7 +89,7 @@ bool StepGen::start_profile(const MoveSpec& spec) {
     uint32_t entry = have_handover_ ? handover_v2_ : spec.v_entry2;
     have_handover_ = false;
     origin_ = 0;
-    prepare_profile(entry, spec.v_exit2);
+    prepare_profile(entry);
     // (read only while holding: a hold begun later sets them again)
     a_hold_ = prof_.a_entry;
     x2_hold_ = 0;
@@ -116,17 +121,24 @@ __attribute__((always_inline)) inline void StepGen::build_k_table(uint8_t group)
     //   K[P] = L_P * count_g / sum_g  (Q20), and 1 for a run without a regulated axis.
     // The step lengths (one square root each) depend on the axis sets only: kept from the
     // previous line (consecutive lines mostly move the same axes in the same order).
+    // Every entry is forgotten when the lengths are not valid (a curve's state overwrote them,
+    // or the settings changed), not only the first `sets`: a later line with more axes would
+    // otherwise read entries that a curve left, where a stale byte can look like its set. 0xFF
+    // is no set (mask < 2^kAxes).
+    if (!lens_valid_) {
+        for (uint8_t& set : ln_.lens_set) set = 0xFF;
+    }
+    lens_valid_ = true;
     uint32_t* lens = ln_.lens;
     uint32_t sum_hi, sum_lo, count_g;
     for (;;) {
         for (uint8_t sub = 0; sub < sets; ++sub) {
             uint8_t set = static_cast<uint8_t>(ln_.mask[sub] & group);
-            if (!lens_valid_ || ln_.lens_set[sub] != set) {
+            if (ln_.lens_set[sub] != set) {
                 ln_.lens_set[sub] = set;
                 lens[sub] = step_length(*lengths_, set);
             }
         }
-        lens_valid_ = true;
         // sum_g exact in two halves (n < 2^23, len < 2^32, m <= 6 terms): mul_wide() and a carry
         // are smaller than avr-gcc 5.4's uint64_t (__umulsidi3, __adddi3, __lshrdi3 and the moves)
         sum_hi = sum_lo = count_g = 0;
@@ -168,7 +180,6 @@ uint32_t StepGen::a_of(uint32_t v2) const {
 bool StepGen::begin_curve(const MoveSpec& spec) {
     const CurveParams& c = *spec.curve;
     if (!um_q8_per_step_) return false;
-    ln_.g.m = 0;
     lens_valid_ = false; // the curve's state overwrites the lines
     // plane_axes(): (u, v, w) = (X, Y, Z), (Z, X, Y), (Y, Z, X), i.e. axis (k - plane) mod 3.
     for (uint8_t k = 0, a = static_cast<uint8_t>(3 - c.plane); k < 3; ++k, ++a) {
@@ -215,10 +226,10 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
     cv_.ref_um = ref_um;
     cv_.x_q8 = 0;
     cv_.chord_left = 0; // no chord yet (fill_curve)
-    return start_profile(spec);
+    return true;
 }
 
-void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2) {
+void StepGen::prepare_profile(uint32_t v_entry2) {
     const uint32_t d1 = ref_len();
     const uint32_t remaining_ticks = d1 - origin_;
     // From psi = 1 / (dv2 d_1), one division (dv2 = 2 a L, a = 128000 dv2 / len_q8):
@@ -237,7 +248,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2) {
     dn.sqrt().mul(len_q8_).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
-    uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2)), remaining_ticks);
+    uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2_)), remaining_ticks);
     // D 2^m = dn.m 2^(dn.e + m) is below 2^32 - 1 while dn.e + m <= e_lim (D = 0: always).
     int8_t e_lim = dn.m == 0xFFFFFFFFul ? -1 : 0;
     if (dn.m == 0) e_lim = 127;
@@ -250,7 +261,7 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2) {
     prof_.d = remaining_ticks;
     prof_.a_cruise = a_of(v_nominal2_);
     prof_.a_entry = a_of(v_entry2);
-    set_a_exit(a_of(v_exit2));
+    set_a_exit();
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
     prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(t.set(feed_).mul(d1)).u32();
@@ -271,21 +282,19 @@ void StepGen::prepare_profile(uint32_t v_entry2, uint32_t v_exit2) {
     }
 }
 
-void StepGen::set_a_exit(uint32_t a) {
+void StepGen::set_a_exit() {
+    const uint32_t a = a_of(v_exit2_);
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
-    // A move that enters and leaves at cruise speed cruises from end to end: profile_a() is
-    // A_cruise everywhere (delta_at() skips it) and the end deceleration starts at its end
-    // (what profile_x2_decel gives then). Chains of short moves are made of such moves.
-    cruising_ = prof_.a_entry == prof_.a_cruise && prof_.a_exit == prof_.a_cruise;
-    x2_decel_ = profile_x2_decel(prof_);
 }
 
 void StepGen::set_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
-    if (v_exit2 == v_exit2_) return;   // called at every poll: usually no change
-    if (x2_now() >= x2_decel_) return; // end deceleration already begun
+    if (v_exit2 == v_exit2_) return; // called at every poll: usually no change
+    // end deceleration already begun (the point from the profile in force: set_exit() is the
+    // only reader, and its test is rarely reached)
+    if (x2_now() >= profile_x2_decel(prof_)) return;
     v_exit2_ = v_exit2;
-    set_a_exit(a_of(v_exit2));
+    set_a_exit();
 }
 
 void StepGen::hold() {
@@ -301,7 +310,7 @@ void StepGen::resume(uint32_t v_exit2) {
     if (!stopped_) return;
     v_exit2_ = v_exit2;
     origin_ = progress();
-    prepare_profile(0, v_exit2);
+    prepare_profile(0);
 }
 
 uint32_t StepGen::speed2() const {
@@ -309,7 +318,7 @@ uint32_t StepGen::speed2() const {
 }
 
 void StepGen::pushed_position(int32_t out[kAxes]) const {
-    for (uint8_t a = 0; a < kAxes; ++a) out[a] = start_[a];
+    memcpy(out, start_, sizeof(start_));
     if (curve_) {
         for (uint8_t k = 0; k < 3; ++k) out[cv_.axes[k]] = cv_.w.pos[k];
         return;
@@ -319,13 +328,16 @@ void StepGen::pushed_position(int32_t out[kAxes]) const {
     const uint8_t dirs = ln_.g.dirs;
     for (uint8_t j = ln_.g.m; j; --j) {
         uint8_t a = *axis++;
-        int32_t p = static_cast<int32_t>(*pos++);
-        out[a] += ((dirs >> a) & 1) ? -p : p;
+        uint32_t p = *pos++;
+        uint8_t d = dirs;
+        for (uint8_t i = a; i; --i) d = static_cast<uint8_t>(d >> 1);
+        if (d & 1) p = 0u - p;
+        out[a] = static_cast<int32_t>(static_cast<uint32_t>(out[a]) + p);
     }
 }
 
 void StepGen::set_position(const int32_t steps[kAxes]) {
-    for (uint8_t a = 0; a < kAxes; ++a) start_[a] = steps[a];
+    memcpy(start_, steps, sizeof(start_));
     ln_.g.m = 0;
     curve_ = nullptr;
     active_ = false;
@@ -406,10 +418,9 @@ void StepGen::emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint
 }
 
 uint32_t StepGen::delta_at(uint32_t x2) {
-    if (cruising_ && !holding_) {
-        a_last_ = prof_.a_cruise; // profile_a(x2) == a_cruise: no evaluation
-        return prof_.cruise;
-    }
+    // (A move that enters and leaves at cruise speed, as in chains of short moves, is at
+    // A_cruise everywhere and takes the shortcut below after profile_a(): a separate test of
+    // such moves before it saved its 370 cycles a segment but cost 70 B.)
     x2 -= 2 * origin_;
     uint32_t a = profile_a(prof_, x2);
     if (holding_) {
@@ -431,7 +442,7 @@ uint32_t StepGen::delta_at(uint32_t x2) {
         changed = root_.seek(a);
     }
     if (changed) {
-        delta_root_ = div32_16(prof_.d_num, static_cast<uint16_t>(root_.r != 0 ? root_.r : 1));
+        delta_root_ = div32_16(prof_.d_num, root_.r != 0 ? root_.r : 1);
 #if LL_STATS
         ++stats.divisions;
 #endif
@@ -584,31 +595,32 @@ void StepGen::fill_curve(RunQueue& q) {
         if (stopped_) break;
         // Delta (cycles x 256 per µm) x chord (µm x 256) / 256.
         uint32_t period_q8 = mul_shr(delta, chord_q8, 8);
-        // Samples of the same axes and directions make one run.
+        // Samples of the same axes and directions make one run (compared as the walker gives
+        // them: the rotation below is one to one).
         // (u, v, w) bits to machine-axis bits: axis (k - plane) mod 3 (begin_curve) is a
-        // rotation of the three bits by plane = 2 - axes[2] to the right.
+        // rotation of the three bits by plane = 2 - axes[2] to the right, once per run.
         const uint8_t plane = static_cast<uint8_t>(2 - cv_.axes[2]);
-        uint8_t run_steps = 0, run_dirs = 0, run_count = 0;
+        uint8_t run_moved = 0, run_neg = 0, run_count = 0;
         // One emit() for both ends of a run: a sample that differs, or none left.
         uint8_t i = 0;
         for (;; ++i) {
             uint8_t moved = 0, neg = 0;
             const bool more = i < n && cv_.w.next(moved, neg);
-            uint8_t steps = static_cast<uint8_t>(moved * 9u), dirs = static_cast<uint8_t>(neg * 9u);
-            for (uint8_t p = plane; p; --p) {
-                steps = static_cast<uint8_t>(steps >> 1);
-                dirs = static_cast<uint8_t>(dirs >> 1);
-            }
-            steps &= 7;
-            dirs &= 7;
-            if (run_count != 0 && (!more || steps != run_steps || (steps && dirs != run_dirs))) {
-                emit(q, run_steps, run_dirs, run_count, period_q8);
+            if (run_count != 0 && (!more || moved != run_moved || (moved && neg != run_neg))) {
+                uint8_t steps = static_cast<uint8_t>(run_moved * 9u);
+                uint8_t dirs = static_cast<uint8_t>(run_neg * 9u);
+                for (uint8_t p = plane; p; --p) {
+                    steps = static_cast<uint8_t>(steps >> 1);
+                    dirs = static_cast<uint8_t>(dirs >> 1);
+                }
+                emit(q, static_cast<uint8_t>(steps & 7), static_cast<uint8_t>(dirs & 7), run_count,
+                     period_q8);
                 run_count = 0;
             }
             if (!more) break;
             if (run_count == 0) {
-                run_steps = steps;
-                run_dirs = steps ? dirs : run_dirs;
+                run_moved = moved;
+                run_neg = moved ? neg : run_neg;
             }
             ++run_count;
         }

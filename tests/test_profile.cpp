@@ -117,7 +117,7 @@ TEST(SqrtTracker, FollowsTheIntegerSquareRootBothWays) {
     for (uint32_t a = 0; a < 200000; a += 37) {
         t.seek(a);
         ASSERT_EQ(t.r, ll::isqrt32(a));
-        ASSERT_EQ(t.c, t.r * t.r);
+        ASSERT_EQ(t.c, static_cast<uint32_t>(t.r) * t.r);
     }
     for (uint32_t a = 200000; a > 1000; a -= 53) {
         t.seek(a);

@@ -53,7 +53,7 @@ inline bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     for (uint8_t a = 0; a < kAxes; ++a, bit = static_cast<uint8_t>(bit << 1)) {
         int32_t d = delta[a];
         if (d == 0) continue;
-        uint32_t dist = d < 0 ? static_cast<uint32_t>(-(d + 1)) + 1u : static_cast<uint32_t>(d);
+        uint32_t dist = abs32(d);
         if (d < 0) g.dirs = static_cast<uint8_t>(g.dirs | bit);
         uint8_t i = g.m;
         while (i > 0 && g.dist[i - 1] < dist) {
@@ -88,15 +88,16 @@ inline bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
 
 /// Macro position along a line (seed §2.1), in ticks travelled per sorted position.
 struct LineCursor {
-    uint32_t x1;          ///< reference-axis ticks travelled
-    uint32_t pos[kAxes];  ///< ticks travelled at each sorted position
+    union {
+        uint32_t x1;         ///< reference-axis ticks travelled (pos[0]: one counter, not two)
+        uint32_t pos[kAxes]; ///< ticks travelled at each sorted position
+    };
     uint32_t frac[kAxes]; ///< fractional part of S_j * x_1 + P/2, k bits, in kLineUnit units
 };
 
 /// (Inline: StepGen::begin() takes it without a call.)
 inline void line_start(const LineGeometry& g, LineCursor& c) {
-    c.x1 = 0;
-    uint32_t* pos = c.pos;
+    uint32_t* pos = c.pos; // (x1 is pos[0])
     uint32_t* frac = c.frac;
     for (uint8_t j = g.m; j; --j) {
         *pos++ = 0;

@@ -62,7 +62,7 @@ uint32_t profile_a(const Profile& p, uint32_t x2);
 /// The integer square root that follows A (seed §8.2), with C = R^2 kept so that a step of R
 /// costs two additions.
 struct SqrtTracker {
-    uint32_t r; ///< floor(sqrt(A))
+    uint16_t r; ///< floor(sqrt(A))
     uint32_t c; ///< r^2
 
     void reset(uint32_t a);

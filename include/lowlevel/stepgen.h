@@ -142,18 +142,18 @@ class StepGen {
     /// A line's part of begin() (out of line: begin()'s frame, under begin_curve(), stays
     /// small).
     bool begin_line(const MoveSpec& spec);
-    /// The profile from origin_ (set first) to the move's end; also clears stopped_ and makes
-    /// the first segment one tick.
-    void prepare_profile(uint32_t v_entry2, uint32_t v_exit2);
+    /// The profile from origin_ (set first) to the move's end, from `v_entry2` to v_exit2_; also
+    /// clears stopped_ and makes the first segment one tick.
+    void prepare_profile(uint32_t v_entry2);
     void take_spec(const MoveSpec& spec);
-    /// What begin() and begin_curve() share: the speeds and the profile over the whole move.
+    /// What begin() does after begin_line() or begin_curve(): the speeds and the profile over the
+    /// whole move (one call for both; out of line: begin()'s frame, under begin_curve(), stays
+    /// small).
     bool start_profile(const MoveSpec& spec);
     void build_k_table(uint8_t group);
     uint32_t a_of(uint32_t v2) const;
-    /// Sets prof_.a_exit to `a` (a_of() of the exit speed; at most A_cruise), then x2_decel_
-    /// and cruising_ from prof_. It calls nothing deep: profile_x2_decel() is inlined in it, and
-    /// the callers take a_of() with their own frames.
-    void set_a_exit(uint32_t a);
+    /// Sets prof_.a_exit to a_of(v_exit2_), at most A_cruise.
+    void set_a_exit();
     void emit(RunQueue& q, uint8_t steps, uint8_t dirs, uint8_t count, uint32_t period_q8);
     /// queued_cycles(q) >= kHorizonCycles.
     bool horizon_full(const RunQueue& q);
@@ -179,8 +179,13 @@ class StepGen {
     uint32_t x2_now() const;
 
     // Most used first: the ATmega328P addresses the first 64 bytes of an object directly (the
-    // order was measured: image size, and llsegcost's cycles per segment for what delta_at()
-    // reads on every segment).
+    // order was measured: image size, by a greedy search over the order of these groups, and
+    // llsegcost's cycles per segment for what delta_at() reads on every segment).
+    // What remains needed of the MoveSpec after begin() (in MoveSpec's order: take_spec() copies
+    // them as one block).
+    uint32_t v_nominal2_, v_exit2_, len_q8_;
+    uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
+    uint16_t min_period_;
     Profile prof_;
     const StepLengths* lengths_;
     const Num* um_q8_per_step_;
@@ -190,25 +195,21 @@ class StepGen {
     bool have_handover_;
     bool root_valid_;
     bool lens_valid_; ///< ln_.lens holds step lengths (no curve ran since, same settings)
-    bool cruising_;   ///< the profile is at cruise from end to end (set_a_exit())
     uint8_t seg_len_;
     uint8_t seen_head_;
-    uint16_t queued_; ///< motion queued ahead of the interrupt, 1024-cycle units
-    uint16_t min_period_;
+    uint32_t a_last_; ///< A of the last segment
     // The move being produced: a line or a curve, never both, so they share their memory.
     const CurveParams* curve_;
     uint32_t origin_; ///< reference tick where the profile starts (moves after a resume)
-    uint32_t a_last_; ///< A of the last segment
+    uint32_t handover_v2_;
     SqrtTracker root_;
-    // What remains needed of the MoveSpec after begin() (in MoveSpec's order: take_spec() copies
-    // them as one block).
-    uint32_t v_nominal2_, v_exit2_, len_q8_;
-    // Only a started move uses these four: begin_curve() borrows their room for the curve's
-    // commanded points (its frame then stays below the 64 bytes the ATmega addresses directly).
+    // Only a started move uses these four (take_spec() sets feed_ after begin_curve()):
+    // begin_curve() borrows their room for the curve's commanded points (its frame then stays
+    // below the 64 bytes the ATmega addresses directly).
     union {
         struct {
             uint32_t delta_root_; ///< d_num / R for the current R
-            uint32_t x2_decel_;   ///< where the end deceleration starts, half ticks from origin_
+            uint32_t feed_;       ///< nominal speed, mm/min x 1000 (MoveSpec)
             // Hold: A(x) = a_hold - s (x - x_hold), half ticks.
             uint32_t a_hold_;
             uint32_t x2_hold_;
@@ -216,21 +217,19 @@ class StepGen {
         int32_t curve_pts_[2][2]; ///< begin_curve(): arc centre and semi-axes, or the Bezier's
                                   ///< control points, ticks x 256
     };
-    uint32_t handover_v2_;
-    Num a_per_v2_;  ///< A per (mm/min)^2 at the profile's scale
-    uint32_t feed_; ///< nominal speed, mm/min x 1000 (MoveSpec)
-    Num dv2_;       ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
+    Num a_per_v2_; ///< A per (mm/min)^2 at the profile's scale
+    Num dv2_;      ///< 2 a L, (mm/min)^2 (MoveSpec::dv2)
     struct LineState {
         uint32_t kmax; ///< largest K of the move
         int32_t k_err; ///< K-time emitted beyond len x Delta_1 so far, Q20 (see fill_line)
-        LineGeometry g;
         LineCursor c;
-        uint32_t k[1u << (kAxes - 1)];   ///< K table, Q20 (see k())
+        LineGeometry g;
         uint8_t mask[1u << (kAxes - 1)]; ///< machine-axis bits of each sorted set
         // Step length of each sorted set (restricted to the regulated group), kept from one
-        // line to the next while lens_valid_: in the room the curve state leaves.
+        // line to the next while lens_valid_ (build_k_table()): in the room the curve state leaves.
         uint32_t lens[1u << (kAxes - 1)];
         uint8_t lens_set[1u << (kAxes - 1)];       ///< the axis set each length is for
+        uint32_t k[1u << (kAxes - 1)];             ///< K table, Q20 (see k())
         uint32_t cruise_period[1u << (kAxes - 1)]; ///< K * Delta_1 at cruise, cycles x 256
         uint8_t cruise_seg;                        ///< segment length at cruise
     };

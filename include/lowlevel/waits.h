@@ -20,9 +20,21 @@ struct StepLengths {
     Num inv2[kAxes]; ///< 1/T_a^2, mm^2 per step^2
 };
 
-/// Builds the table from the steps per unit of each axis (x1000, as in Settings). Requires
-/// T_a >= 1 step per unit.
-void step_lengths_build(StepLengths& t, const uint32_t steps_per_unit_milli[kAxes]);
+/// 1/T^2 into `v` for T = `milli` / 1000 steps per unit (milli >= 1000: the callers clamp it).
+/// (Inline: machine_build() takes it in its own loop over the axes.)
+inline void step_length_inv2(Num& v, uint32_t milli) {
+    v.set(1000).div(milli);
+    v.mul(v);
+}
+
+/// Builds the table from the steps per unit of each axis (x1000, as in Settings), T_a taken as
+/// at least 1 step per unit.
+inline void step_lengths_build(StepLengths& t, const uint32_t steps_per_unit_milli[kAxes]) {
+    for (uint8_t a = 0; a < kAxes; ++a) {
+        const uint32_t tm = steps_per_unit_milli[a];
+        step_length_inv2(t.inv2[a], tm < 1000 ? 1000 : tm);
+    }
+}
 
 /// Length of one micro step on the axis set `set`, mm x 2^30 (Q30): below 4 mm for T >= 1.
 /// (Inline: on the chip only StepGen::begin_line() calls it.)
