@@ -57,12 +57,23 @@ bool starts_with(const std::string& s, const char* p) {
     return s.compare(0, strlen(p), p) == 0;
 }
 
+// One input section of the map, kept when it is not empty.
+void add_section(const std::string& name, const std::string& addr, const std::string& size,
+                 const std::string& file) {
+    Section s;
+    s.name = name;
+    s.addr = std::strtol(addr.c_str(), nullptr, 16);
+    s.size = static_cast<int>(std::strtol(size.c_str(), nullptr, 16));
+    s.file = file;
+    if (s.size > 0) g_sec.push_back(s);
+}
+
 // The .text output section's input sections, from a GNU ld map.
 bool read_map(const char* path) {
     std::ifstream in(path);
     std::string line;
     bool inside = false;
-    std::string pending;
+    std::string pending; // a long name, alone on its line: address, size and file follow
     while (std::getline(in, line)) {
         if (!inside) {
             inside = starts_with(line, ".text ");
@@ -70,36 +81,18 @@ bool read_map(const char* path) {
         }
         if (!line.empty() && line[0] == '.') break; // the next output section
         std::istringstream ss(line);
-        std::string first;
-        ss >> first;
+        std::string first, second, third, fourth;
+        ss >> first >> second >> third >> fourth;
         if (line.size() > 1 && line[0] == ' ' && line[1] == '.') {
-            std::string addr, size, file;
-            if (ss >> addr >> size >> file) {
-                pending.clear();
-            } else {
-                pending = first; // the name alone; address, size and file on the next line
+            if (second.empty()) {
+                pending = first;
                 continue;
             }
-            Section s;
-            s.name = first;
-            s.addr = std::strtol(addr.c_str(), nullptr, 16);
-            s.size = static_cast<int>(std::strtol(size.c_str(), nullptr, 16));
-            s.file = file;
-            if (s.size > 0) g_sec.push_back(s);
-        } else if (!pending.empty() && starts_with(first, "0x")) {
-            std::string size, file;
-            if (ss >> size >> file) {
-                Section s;
-                s.name = pending;
-                s.addr = std::strtol(first.c_str(), nullptr, 16);
-                s.size = static_cast<int>(std::strtol(size.c_str(), nullptr, 16));
-                s.file = file;
-                if (s.size > 0) g_sec.push_back(s);
-            }
-            pending.clear();
-        } else {
-            pending.clear();
+            add_section(first, second, third, fourth);
+        } else if (!pending.empty() && starts_with(first, "0x") && !third.empty()) {
+            add_section(pending, first, second, third);
         }
+        pending.clear();
     }
     std::sort(g_sec.begin(), g_sec.end(),
               [](const Section& a, const Section& b) { return a.addr < b.addr; });
