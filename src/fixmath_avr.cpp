@@ -1167,7 +1167,7 @@ asm(".section .text._ZN2ll11sum_squaresEPKmhh,\"ax\",@progbits\n"
     "movw r12, r24\n" // v
     "mov  r10, r22\n" // n
     "mov  r11, r20\n" // mask
-    "clr  r16\n"      // exp: 0, or 4 when two bits are dropped
+    "clr  r28\n"      // exp: 0, or 4 when two bits are dropped (r28: __ll_mul32 uses r16)
     "tst  r10\n"
     "breq 3f\n"
     "movw r30, r24\n"
@@ -1182,7 +1182,7 @@ asm(".section .text._ZN2ll11sum_squaresEPKmhh,\"ax\",@progbits\n"
     "mov  r27, r0\n"
     "andi r27, 0xC0\n"
     "breq 3f\n"
-    "ldi  r16, 4\n"
+    "ldi  r28, 4\n"
     "3:\n"
     "clr  r2\n" // lo in r2..r5, hi in r6..r9
     "clr  r3\n"
@@ -1199,7 +1199,12 @@ asm(".section .text._ZN2ll11sum_squaresEPKmhh,\"ax\",@progbits\n"
     "movw r12, r30\n"
     "lsr  r11\n"
     "brcc 6f\n" // not in the mask
-    "tst  r16\n"
+    "mov  r0, r18\n"
+    "or   r0, r19\n"
+    "or   r0, r20\n"
+    "or   r0, r21\n"
+    "breq 6f\n" // zero (an axis that does not move): no product
+    "tst  r28\n"
     "breq 5f\n"
     "lsr  r21\n"
     "ror  r20\n"
@@ -1212,7 +1217,7 @@ asm(".section .text._ZN2ll11sum_squaresEPKmhh,\"ax\",@progbits\n"
     "5:\n"
     "movw r22, r18\n"
     "movw r24, r20\n"
-    "call __ll_mul32s\n" // lo r18..r21, hi r22..r25 (r16 kept)
+    "call __ll_mul32\n" // lo r18..r21, hi r22..r25
     "add  r2, r18\n"
     "adc  r3, r19\n"
     "adc  r4, r20\n"
@@ -1230,7 +1235,9 @@ asm(".section .text._ZN2ll11sum_squaresEPKmhh,\"ax\",@progbits\n"
     "movw r20, r4\n"
     "movw r22, r6\n"
     "movw r24, r8\n"
+    "mov  r16, r28\n"
     "call _ZN2ll5num64Emma\n" // exp in r16
+    "in   r28, __SP_L__\n" // Y back to the frame pointer for the restore
     "ldi  r30, 18\n"
     "jmp  __epilogue_restores__\n"
     ".size _ZN2ll11sum_squaresEPKmhh, .-_ZN2ll11sum_squaresEPKmhh\n"
