@@ -197,10 +197,48 @@ uint16_t isqrt32(uint32_t v) {
         "mul  %[sh], %[sh]\n\t"
         "movw %A[hh], r0\n\t"
         "clr  %[sl]\n\t"
+        "sbrs %[sh], 7\n\t"
+        "rjmp 7f\n\t"
+        // sh >= 128 (v >= 2^30, as for Num::sqrt): the low byte from one Newton step instead,
+        // t = min(255, floor((v - sh^2 2^16) / 2^9 / sh)), which is the root's low byte or one
+        // above it (the step never falls short; checked for the largest v of every root, where
+        // the overshoot is largest), so one square decides between t and t - 1. The remainder's
+        // bits 9..24 in %C:%B[sq], divided by sh by restoring division (the quotient shifted
+        // into %B[sq]); bit is 0 after the first loop: the second ends after that square.
+        "movw %A[sq], %A[v]\n\t"
+        "movw %C[sq], %C[v]\n\t"
+        "sub  %C[sq], %A[hh]\n\t"
+        "sbc  %D[sq], %B[hh]\n\t"
+        "lsr  %D[sq]\n\t"
+        "ror  %C[sq]\n\t"
+        "ror  %B[sq]\n\t"
+        "ldi  %[t], 0xFF\n\t" // when the quotient has 9 bits
+        "cp   %C[sq], %[sh]\n\t"
+        "brsh 6f\n\t"
+        "ldi  %[t], 8\n"
+        "5:\n\t"
+        "lsl  %B[sq]\n\t"
+        "rol  %C[sq]\n\t"
+        "brcs 8f\n\t"
+        "cp   %C[sq], %[sh]\n\t"
+        "brcs 9f\n"
+        "8:\n\t"
+        "sub  %C[sq], %[sh]\n\t"
+        "inc  %B[sq]\n"
+        "9:\n\t"
+        "dec  %[t]\n\t"
+        "brne 5b\n\t"
+        "mov  %[t], %B[sq]\n"
+        "6:\n\t"
+        "mov  %[sl], %[t]\n\t"
+        "dec  %[sl]\n\t"
+        "rjmp 10f\n"
+        "7:\n\t"
         "ldi  %[bit], 0x80\n"
         "3:\n\t"
         "mov  %[t], %[sl]\n\t"
-        "or   %[t], %[bit]\n\t"
+        "or   %[t], %[bit]\n"
+        "10:\n\t"
         "mul  %[t], %[t]\n\t" // (sh * 256 + t)^2 = t^2 + 2 sh t 256 + sh^2 65536
         "movw %A[sq], r0\n\t"
         "movw %C[sq], %A[hh]\n\t"
@@ -221,7 +259,7 @@ uint16_t isqrt32(uint32_t v) {
         "lsr  %[bit]\n\t"
         "brne 3b\n\t"
         "clr  __zero_reg__"
-        : [sh] "=&r"(sh), [sl] "=&r"(sl), [t] "=&r"(t), [bit] "=&d"(bit), [z] "=&r"(zero),
+        : [sh] "=&r"(sh), [sl] "=&r"(sl), [t] "=&d"(t), [bit] "=&d"(bit), [z] "=&r"(zero),
           [hh] "=&r"(hh), [sq] "=&r"(sq)
         : [v] "r"(v));
     return static_cast<uint16_t>(sh << 8 | sl);
