@@ -34,6 +34,17 @@ inline uint32_t fixmath_edges() {
             }
         }
     }
+    // Products and quotients at the ends of the exponent range: saturated, zero, just inside.
+    const int8_t es[7] = {-128, -97, -64, 0, 64, 95, 127};
+    for (uint8_t i = 0; i < 7; ++i) {
+        for (uint8_t j = 0; j < 7; ++j) {
+            ll::Num x(0xC0000001ul, es[i]), y(0x80000003ul, es[j]);
+            h.add(ll::Num(x).mul(y));
+            h.add(ll::Num(y).mul(x));
+            h.add(ll::Num(x).div(y));
+            h.add(ll::Num(y).div(x));
+        }
+    }
     return h.h;
 }
 
