@@ -702,7 +702,7 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "pop  r15\n"
     "pop  r14\n"
     "pop  r13\n"
-    ".Lshr_sat:\n" // r18..r25 >> r30 (any count), saturated to 32 bits, into r22..r25
+    ".Lshr_sat:\n"   // r18..r25 >> r30 (any count), saturated to 32 bits, into r22..r25
     "cpi  r30, 16\n" // 16 bits at a time by word moves (9 cycles instead of 26)
     "brlo 1f\n"
     "movw r18, r20\n"
@@ -1184,8 +1184,9 @@ asm(".section .progmem.data.__ll_atan_q29,\"a\",@progbits\n"
 // Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask): v in r24:r25, n in r22, mask in
 // r20; the Num in r18..r22 as num64 returns it. fixmath.cpp's C in one routine: the top bytes of
 // all n values ORed (any >= 0x40: every value loses two bits, exp 4), then the squares of the
-// masked values summed exactly in r2..r9 (squares of zero add nothing: no test) and num64. The
-// registers are saved by libgcc's __prologue_saves__ (Y the frame pointer for the restore).
+// masked nonzero values summed exactly in r2..r9 (a zero, an axis that does not move, skips its
+// product: about 100 cycles) and num64. The registers are saved by libgcc's __prologue_saves__
+// (Y the frame pointer for the restore; r28 holds exp meanwhile, __ll_mul32 using r16).
 asm(".section .text._ZN2ll11sum_squaresEPKmhh,\"ax\",@progbits\n"
     ".global _ZN2ll11sum_squaresEPKmhh\n"
     ".type _ZN2ll11sum_squaresEPKmhh, @function\n"
@@ -1269,7 +1270,7 @@ asm(".section .text._ZN2ll11sum_squaresEPKmhh,\"ax\",@progbits\n"
     "movw r24, r8\n"
     "mov  r16, r28\n"
     "call _ZN2ll5num64Emma\n" // exp in r16
-    "in   r28, __SP_L__\n" // Y back to the frame pointer for the restore
+    "in   r28, __SP_L__\n"    // Y back to the frame pointer for the restore
     "ldi  r30, 18\n"
     "jmp  __epilogue_restores__\n"
     ".size _ZN2ll11sum_squaresEPKmhh, .-_ZN2ll11sum_squaresEPKmhh\n"
