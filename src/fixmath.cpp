@@ -174,14 +174,13 @@ inline uint32_t shr_sat(uint32_t hi, uint32_t lo, uint8_t shift) {
 
 uint16_t isqrt32(uint32_t v) {
 #if defined(__AVR__)
-    // Bit by bit from the top, with hardware squares: the high byte against the top 16 bits of
-    // v (one 8x8 product per bit), then the low byte against all of v (two products per bit,
-    // the high byte's square computed once).
-    uint8_t sh, sl, t, bit, zero;
-    uint16_t hh;
+    // Bit by bit from the top, with hardware squares: the high byte sh against the top 16 bits
+    // of v (one 8x8 product per bit), then the low byte t against rem = v - sh^2 2^16, in place
+    // of v (t^2 + 2 sh t 2^8 <= rem: two products per bit, subtracted from a copy of rem).
+    // Twelve upper registers, all call-clobbered: no register saved.
+    uint8_t sh, sl, t, bit;
     uint32_t sq;
-    asm("clr  %[z]\n\t"
-        "clr  %[sh]\n\t"
+    asm("clr  %[sh]\n\t"
         "ldi  %[bit], 0x80\n"
         "1:\n\t"
         "mov  %[t], %[sh]\n\t"
@@ -194,36 +193,75 @@ uint16_t isqrt32(uint32_t v) {
         "2:\n\t"
         "lsr  %[bit]\n\t"
         "brne 1b\n\t"
-        "mul  %[sh], %[sh]\n\t"
-        "movw %A[hh], r0\n\t"
+        "mul  %[sh], %[sh]\n\t" // rem < 2^25
+        "sub  %C[v], r0\n\t"
+        "sbc  %D[v], r1\n\t"
         "clr  %[sl]\n\t"
+        "sbrs %[sh], 7\n\t"
+        "rjmp 7f\n\t"
+        // sh >= 128 (v >= 2^30, as for Num::sqrt): the low byte from one Newton step instead,
+        // t = min(255, floor(rem / 2^9 / sh)), which is the root's low byte or one above it
+        // (the step never falls short; checked for the largest v of every root, where the
+        // overshoot is largest), so one test decides between t and t - 1. rem's bits 9..24 in
+        // %C:%B[sq], divided by sh by restoring division (the quotient shifted into %B[sq]);
+        // bit is 0 after the first loop: the second ends after that test.
+        "mov  %B[sq], %B[v]\n\t"
+        "mov  %C[sq], %C[v]\n\t"
+        "mov  %D[sq], %D[v]\n\t"
+        "lsr  %D[sq]\n\t"
+        "ror  %C[sq]\n\t"
+        "ror  %B[sq]\n\t"
+        "ldi  %[t], 0xFF\n\t" // when the quotient has 9 bits
+        "cp   %C[sq], %[sh]\n\t"
+        "brsh 6f\n\t"
+        "ldi  %[t], 8\n"
+        "5:\n\t"
+        "lsl  %B[sq]\n\t"
+        "rol  %C[sq]\n\t"
+        "brcs 8f\n\t"
+        "cp   %C[sq], %[sh]\n\t"
+        "brcs 9f\n"
+        "8:\n\t"
+        "sub  %C[sq], %[sh]\n\t"
+        "inc  %B[sq]\n"
+        "9:\n\t"
+        "dec  %[t]\n\t"
+        "brne 5b\n\t"
+        "mov  %[t], %B[sq]\n"
+        "6:\n\t"
+        "mov  %[sl], %[t]\n\t"
+        "dec  %[sl]\n\t"
+        "rjmp 10f\n"
+        "7:\n\t"
         "ldi  %[bit], 0x80\n"
         "3:\n\t"
         "mov  %[t], %[sl]\n\t"
-        "or   %[t], %[bit]\n\t"
-        "mul  %[t], %[t]\n\t" // (sh * 256 + t)^2 = t^2 + 2 sh t 256 + sh^2 65536
-        "movw %A[sq], r0\n\t"
-        "movw %C[sq], %A[hh]\n\t"
+        "or   %[t], %[bit]\n"
+        "10:\n\t"
+        "mul  %[t], %[t]\n\t" // rem - t^2 - sh t 2^8 - sh t 2^8 >= 0, or a borrow
+        "movw %A[sq], %A[v]\n\t"
+        "movw %C[sq], %C[v]\n\t"
+        "sub  %A[sq], r0\n\t"
+        "sbc  %B[sq], r1\n\t"
+        "sbci %C[sq], 0\n\t"
+        "sbci %D[sq], 0\n\t"
+        "brcs 4f\n\t"
         "mul  %[t], %[sh]\n\t"
-        "add  %B[sq], r0\n\t"
-        "adc  %C[sq], r1\n\t"
-        "adc  %D[sq], %[z]\n\t"
-        "add  %B[sq], r0\n\t"
-        "adc  %C[sq], r1\n\t"
-        "adc  %D[sq], %[z]\n\t"
-        "cp   %A[v], %A[sq]\n\t"
-        "cpc  %B[v], %B[sq]\n\t"
-        "cpc  %C[v], %C[sq]\n\t"
-        "cpc  %D[v], %D[sq]\n\t"
+        "sub  %B[sq], r0\n\t"
+        "sbc  %C[sq], r1\n\t"
+        "sbci %D[sq], 0\n\t"
+        "brcs 4f\n\t"
+        "sub  %B[sq], r0\n\t"
+        "sbc  %C[sq], r1\n\t"
+        "sbci %D[sq], 0\n\t"
         "brcs 4f\n\t"
         "mov  %[sl], %[t]\n"
         "4:\n\t"
         "lsr  %[bit]\n\t"
         "brne 3b\n\t"
         "clr  __zero_reg__"
-        : [sh] "=&r"(sh), [sl] "=&r"(sl), [t] "=&r"(t), [bit] "=&d"(bit), [z] "=&r"(zero),
-          [hh] "=&r"(hh), [sq] "=&r"(sq)
-        : [v] "r"(v));
+        : [sh] "=&d"(sh), [sl] "=&d"(sl), [t] "=&d"(t), [bit] "=&d"(bit), [sq] "=&d"(sq),
+          [v] "+d"(v));
     return static_cast<uint16_t>(sh << 8 | sl);
 #else
     uint32_t res = 0;
