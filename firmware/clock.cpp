@@ -17,6 +17,7 @@ volatile uint32_t s_millis; // ms since clock_init(), wraps after 49.7 days
 // version saves r0, r1 and four registers for a 32-bit add; the unrolled form took 22 B more).
 ISR(TIMER2_COMPA_vect, ISR_NAKED) {
     asm volatile("sei\n\t"
+                 "nop\n\t" // runs before any interrupt (as any instruction after sei): 1 cycle
                  "push r24\n\t"
                  "in   r24, __SREG__\n\t"
                  "push r24\n\t"
