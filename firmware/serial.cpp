@@ -3,7 +3,7 @@
 // Neither handler may delay the step interrupt by more than a few cycles, so both re-enable
 // interrupts as soon as their source is cleared:
 //   - receive: a naked stub disables the receive interrupt (one constant store: nothing else
-//     ever changes UCSR0B) and re-enables interrupts, 8 cycles after the vector; the rest runs
+//     ever changes UCSR0B) and re-enables interrupts, 6 cycles after the vector; the rest runs
 //     interruptible in rx_drain(), which takes the oldest byte of the 2-byte hardware FIFO and
 //     then re-enables the receive interrupt (which comes again at once for a second byte). Order
 //     can never be swapped by a nested receive.
@@ -71,15 +71,21 @@ void __vector_rx_drain() {
     UCSR0B = kUcsr0bRun;
 }
 
+// r24 is kept in OCR0A, not on the stack: out/in take 1 cycle each where push/pop take 2, so
+// interrupts stay off 13 cycles from acceptance instead of 15 (4 response, 3 jmp, out, ldi,
+// sts, sei, in: the instruction after sei runs before any interrupt). Timer0 is never started
+// and its interrupts and output pins stay off (reset values), so OCR0A is free scratch; any
+// other user must also use it with interrupts off only, as here.
 ISR(USART_RX_vect, ISR_NAKED) {
-    asm volatile("push r24\n\t"
+    asm volatile("out  %[scratch], r24\n\t"
                  "ldi  r24, %[masked]\n\t"
                  "sts  %[ucsr0b], r24\n\t"
                  "sei\n\t"
-                 "pop  r24\n\t"
+                 "in   r24, %[scratch]\n\t"
                  "rjmp __vector_rx_drain\n\t"
                  :
-                 : [masked] "M"(ll::kUcsr0bRxMasked), [ucsr0b] "n"(_SFR_MEM_ADDR(UCSR0B)));
+                 : [masked] "M"(ll::kUcsr0bRxMasked), [ucsr0b] "n"(_SFR_MEM_ADDR(UCSR0B)),
+                   [scratch] "I"(_SFR_IO_ADDR(OCR0A)));
 }
 
 // The shift register is empty: the first byte goes straight into it, the second waits in UDR0,
