@@ -71,11 +71,12 @@ void __vector_rx_drain() {
     UCSR0B = kUcsr0bRun;
 }
 
-// r24 is kept in OCR0A, not on the stack: out/in take 1 cycle each where push/pop take 2, so
+// r24 is kept in OCR0B, not on the stack: out/in take 1 cycle each where push/pop take 2, so
 // interrupts stay off 13 cycles from acceptance instead of 15 (4 response, 3 jmp, out, ldi,
-// sts, sei, in: the instruction after sei runs before any interrupt). Timer0 is never started
-// and its interrupts and output pins stay off (reset values), so OCR0A is free scratch; any
-// other user must also use it with interrupts off only, as here.
+// sts, sei, in: the instruction after sei runs before any interrupt). Timer0 counts
+// milliseconds in CTC mode up to OCR0A (clock.cpp), so OCR0B only sets a flag nobody enables
+// (OCIE0B and COM0B stay 0): free scratch; any other user must also hold it with interrupts
+// off only, as here.
 ISR(USART_RX_vect, ISR_NAKED) {
     asm volatile("out  %[scratch], r24\n\t"
                  "ldi  r24, %[masked]\n\t"
@@ -85,7 +86,7 @@ ISR(USART_RX_vect, ISR_NAKED) {
                  "rjmp __vector_rx_drain\n\t"
                  :
                  : [masked] "M"(ll::kUcsr0bRxMasked), [ucsr0b] "n"(_SFR_MEM_ADDR(UCSR0B)),
-                   [scratch] "I"(_SFR_IO_ADDR(OCR0A)));
+                   [scratch] "I"(_SFR_IO_ADDR(OCR0B)));
 }
 
 // The shift register is empty: the first byte goes straight into it, the second waits in UDR0,
