@@ -64,9 +64,25 @@ void clock_init() {
 namespace hal {
 
 uint32_t millis() {
-    // Interrupts off for the four loads (cli to restore: 10 cycles).
-    fw::IrqGuard g;
-    return s_millis;
+    // Without a critical section (it kept interrupts off 10 cycles): the four bytes low to high,
+    // then the low byte again. Every tick changes the low byte, so if it is unchanged no tick
+    // came between the loads (256 ticks, 256 ms, in between cannot happen), and the bytes
+    // belong together; otherwise read again. In assembly: C's loop was 34 B, this one 2 B more
+    // than the cli version.
+    uint32_t t;
+    uint8_t again;
+    asm volatile("1:\n\t"
+                 "lds  %A0, %[ms]\n\t"
+                 "lds  %B0, %[ms]+1\n\t"
+                 "lds  %C0, %[ms]+2\n\t"
+                 "lds  %D0, %[ms]+3\n\t"
+                 "lds  %[again], %[ms]\n\t"
+                 "cpse %[again], %A0\n\t"
+                 "rjmp 1b\n\t"
+                 : "=&r"(t), [again] "=&r"(again)
+                 : [ms] "i"(&s_millis)
+                 : "memory");
+    return t;
 }
 
 } // namespace hal
