@@ -1,6 +1,11 @@
-// Millisecond clock: Timer2 in CTC mode, prescaler 64, OCR2A = 249 -> one interrupt per ms.
+// Millisecond clock: Timer0 in CTC mode, prescaler 64, OCR0A = 249 -> one interrupt per ms.
 // The compare flag clears itself when the vector runs, so the handler re-enables interrupts
-// first: it can delay a step edge by its 4-cycle entry, the jmp and the sei only.
+// first: it can delay a step edge by its 4-cycle entry, the jmp, the sei and one nop only.
+// Timer0, not Timer2: its vector (14) ranks below the step interrupts' (11, 12), so when the
+// tick and a step compare match are pending together the step goes first. With Timer2
+// (vector 7) the tick went first and the step edge waited for the rest of the instruction under
+// way plus the tick's 9 cycles (measured: 11). OCR0B stays free (serial.cpp's receive stub uses
+// it as scratch: compare B only sets a flag, OCIE0B and COM0B are off).
 #include <avr/interrupt.h>
 #include <avr/io.h>
 
@@ -15,8 +20,9 @@ volatile uint32_t s_millis; // ms since clock_init(), wraps after 49.7 days
 
 // s_millis + 1, a byte at a time through Z, stopping at the first byte that does not wrap (C's
 // version saves r0, r1 and four registers for a 32-bit add; the unrolled form took 22 B more).
-ISR(TIMER2_COMPA_vect, ISR_NAKED) {
+ISR(TIMER0_COMPA_vect, ISR_NAKED) {
     asm volatile("sei\n\t"
+                 "nop\n\t" // runs before any interrupt (as any instruction after sei): 1 cycle
                  "push r24\n\t"
                  "in   r24, __SREG__\n\t"
                  "push r24\n\t"
@@ -46,11 +52,11 @@ namespace ll {
 namespace fw {
 
 void clock_init() {
-    // TCNT2 and the flags keep their reset value 0 (main.cpp).
-    TCCR2A = _BV(WGM21); // CTC
-    OCR2A = 249;         // 250 ticks of 4 µs
-    TIMSK2 = _BV(OCIE2A);
-    TCCR2B = _BV(CS22); // clk/64
+    // TCNT0 and the flags keep their reset value 0 (main.cpp).
+    TCCR0A = _BV(WGM01); // CTC
+    OCR0A = 249;         // 250 ticks of 4 µs
+    TIMSK0 = _BV(OCIE0A);
+    TCCR0B = _BV(CS01) | _BV(CS00); // clk/64
 }
 
 } // namespace fw
@@ -58,9 +64,25 @@ void clock_init() {
 namespace hal {
 
 uint32_t millis() {
-    // Interrupts off for the four loads (cli to restore: 10 cycles).
-    fw::IrqGuard g;
-    return s_millis;
+    // Without a critical section (it kept interrupts off 10 cycles): the four bytes low to high,
+    // then the low byte again. Every tick changes the low byte, so if it is unchanged no tick
+    // came between the loads (256 ticks, 256 ms, in between cannot happen), and the bytes
+    // belong together; otherwise read again. In assembly: C's loop was 34 B, this one 2 B more
+    // than the cli version.
+    uint32_t t;
+    uint8_t again;
+    asm volatile("1:\n\t"
+                 "lds  %A0, %[ms]\n\t"
+                 "lds  %B0, %[ms]+1\n\t"
+                 "lds  %C0, %[ms]+2\n\t"
+                 "lds  %D0, %[ms]+3\n\t"
+                 "lds  %[again], %[ms]\n\t"
+                 "cpse %[again], %A0\n\t"
+                 "rjmp 1b\n\t"
+                 : "=&r"(t), [again] "=&r"(again)
+                 : [ms] "i"(&s_millis)
+                 : "memory");
+    return t;
 }
 
 } // namespace hal

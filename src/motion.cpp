@@ -222,13 +222,20 @@ bool abort() {
 void position(int32_t steps[kAxes]) {
     Motion& m = mo();
     uint8_t i, n, s, d;
-    {
-        hal::Critical cs;
+    // Without a critical section (it kept interrupts off 10 cycles, the main loop's longest
+    // window): read, then retry if the step interrupt ran in between. Each of its runs either
+    // decrements `remaining` (not the run's last event), or pops a run (`head` moves), or, at
+    // the last event with the queue empty, sets `remaining` from 1 to 0. Several runs cannot
+    // undo each other: without a pop `remaining` only falls, and the pops in one pass are at
+    // most the N - 1 runs queued when it started (this loop is the producer, so nothing is
+    // queued meanwhile), so `head` cannot come back to its value. Equal `head` and `remaining`
+    // at the end thus mean that the four values belong together.
+    do {
         i = g_runs.head;
         n = g_exec.remaining;
         s = g_exec.steps;
         d = g_exec.dirs;
-    }
+    } while (n != g_exec.remaining || i != g_runs.head);
     m.gen.pushed_position(steps);
     // Undo what is queued but not executed: the rest of the current run, then every run
     // between the consumer and the producer.
