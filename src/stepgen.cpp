@@ -462,20 +462,27 @@ __attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t
 #endif
     uint8_t next = 1;
     if (longest <= 0xFFFF00ul) {
+        // The shortest power of two lasting kSegmentCycles, as long as the speed stays within its
+        // tolerance over the segment (docs/motion.md, "Speed accuracy"): a tick u away from the
+        // segment's midpoint runs off by u / (2 l), with l = A / s ticks from rest, which the
+        // tolerance allows for segments of up to 16 ticks. Measured against it, segments of up to
+        // 8 ticks use about half (l >= 4 L keeps the second-order terms small), 16 ticks all of
+        // it, so 16 and 32 are taken only where the speed is steady: 32 ticks give 8 / l where
+        // 16-tick segments are allowed 4 / l, and 4 / l <= 1 / Delta (the allowance for whole
+        // cycles) once l >= 4 Delta; 64 ticks more cover how far A moves until the next segment.
+        // Segments shorter than kMinSegmentCycles are never made: producing one costs about
+        // 3,000 cycles when its speed changes.
         uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8; // / next: a shift
+        uint32_t least = static_cast<uint32_t>(kMinSegmentCycles) << 8;
+        const uint32_t l = a >> prof_.log_s; // ticks from rest
+        const bool steady = l >= (longest >> 6) + 64;
         while (next < 16 && delta < target) {
+            if (!(next < 8 ? l >= 16u * next : steady) && (delta >= least || l < 8u * next)) break;
             next = static_cast<uint8_t>(next << 1);
             target >>= 1;
+            least >>= 1;
         }
-        // Above 41.7 k steps/s 16 ticks last less than kSegmentCycles, and a segment whose
-        // speed changes costs about 3,000 cycles to produce, more than 16 ticks leave at 152
-        // cycles a step (docs/verification.md): 32 ticks, but only where that keeps the speed
-        // within the tolerance stated for 16 (docs/motion.md, "Speed accuracy"). A tick u away
-        // from the segment's midpoint runs off by u / (2 l) with l = A / s ticks from rest; 16
-        // ticks give 8 / l where 16-tick segments are allowed 4 / l, and 4 / l <= 1 / Delta
-        // (the allowance for whole cycles) once l >= 4 Delta; 64 ticks more cover how far A
-        // moves until the next segment.
-        if (delta < target && (a >> prof_.log_s) >= (longest >> 6) + 64) next = kMaxSegmentTicks;
+        if (next == 16 && delta < least && steady) next = kMaxSegmentTicks;
     }
     return next;
 }
@@ -637,7 +644,7 @@ void StepGen::fill_curve(RunQueue& q) {
         // A curve segment costs a chord (a square root) on top of its samples: 8x the line
         // segment duration keeps that cost to a fraction of the time the samples take (one
         // sample when it needs idle waits).
-        seg_len_ = next_segment(period_q8 >> 3, period_q8, 0);
+        seg_len_ = next_segment(period_q8 >> 3, period_q8, 0xFFFFFFFFul);
         if (cv_.w.done()) finish_move();
     }
 }

@@ -807,8 +807,8 @@ int run(int argc, char** argv) {
             segments ? static_cast<double>(costs[1].cycles) / static_cast<double>(segments) : 0;
         rows.push_back({"Step generation per macro segment (StepGen::fill)",
                         thousands(per_segment) + " cycles",
-                        "< " + thousands(ll::kSegmentCycles) + " (kSegmentCycles)", "—",
-                        per_segment < ll::kSegmentCycles ? "yes" : "no"});
+                        "< " + thousands(ll::kMinSegmentCycles) + " (kMinSegmentCycles)", "—",
+                        per_segment < ll::kMinSegmentCycles ? "yes" : "no"});
     }
 
     if (cfg.want("circle")) {

@@ -28,7 +28,13 @@ namespace ll {
 /// mm/s stream of FirmwareRunQueue, 44 % of the 80,000 cycles such a line lasts. 2048 (the
 /// first value) and 4096 were below that budget and the run queue ran dry mid-move (22
 /// times at the 264-cycle minimum period with 2048; 57 times in that stream with 4096).
-constexpr uint16_t kSegmentCycles = 6144;
+constexpr uint16_t kMinSegmentCycles = 6144;
+/// Duration a macro segment is given where the speed tolerance allows (next_segment()), CPU
+/// cycles: fewer segments per move leave the main loop more time for short lines. A 0.1 mm line
+/// at 50 mm/s lasts 32,000 cycles and has 6 to 8 reference ticks: 6144 cut it into 7 segments
+/// of about 3,000 cycles each, and the circle of such lines (docs/benchmarks.md) ran at
+/// 1.74 x its ideal time, the CPU being the limit.
+constexpr uint16_t kSegmentCycles = 32768;
 /// How far ahead of the step interrupt the generator commits motion, CPU cycles (4 ms). Motion
 /// not yet produced can still be replanned (a later move raising this one's exit speed, a feed
 /// hold), so the generator stays this close behind the interrupt; the main loop must come back
