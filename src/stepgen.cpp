@@ -492,8 +492,8 @@ void StepGen::finish_move() {
     have_handover_ = true;
     // The speed reached, which is below the planned exit when a raised exit came too late for
     // a short move to accelerate to it (the next move must start from what was reached).
-    uint32_t reached = speed2();
-    handover_v2_ = holding_ || reached < v_exit2_ ? reached : v_exit2_;
+    // (The planned exit when the last segment's A reached the exit's: no division then.)
+    handover_v2_ = holding_ || a_last_ < prof_.a_exit ? speed2() : v_exit2_;
 }
 
 void StepGen::fill_line(RunQueue& q) {
