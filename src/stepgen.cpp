@@ -267,7 +267,11 @@ void StepGen::prepare_profile(uint32_t v_entry2) {
     prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(t.set(feed_).mul(d1)).u32();
     root_valid_ = false;
     stopped_ = false;
-    seg_len_ = 1;
+    // The first segment: one tick from rest; a line entering at speed keeps the length of the
+    // last segment before it, chosen for the same speed (the entry is the previous exit), and
+    // so does not spend a segment on one tick (a 0.1 mm line has only 6 to 8). A curve sets 1
+    // when it ends: its segment lengths count samples, not ticks.
+    if (v_entry2 == 0 || seg_len_ == 0) seg_len_ = 1;
     if (!curve_) {
         // The runs' periods at cruise, for fill_line (one product per axis set and move).
         // The longest is K_max's (mul_shr() is monotonic in the factor).
@@ -645,7 +649,10 @@ void StepGen::fill_curve(RunQueue& q) {
         // segment duration keeps that cost to a fraction of the time the samples take (one
         // sample when it needs idle waits).
         seg_len_ = next_segment(period_q8 >> 3, period_q8, 0xFFFFFFFFul);
-        if (cv_.w.done()) finish_move();
+        if (cv_.w.done()) {
+            seg_len_ = 1;
+            finish_move();
+        }
     }
 }
 

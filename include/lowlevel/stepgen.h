@@ -149,7 +149,7 @@ class StepGen {
     /// small).
     bool begin_line(const MoveSpec& spec);
     /// The profile from origin_ (set first) to the move's end, from `v_entry2` to v_exit2_; also
-    /// clears stopped_ and makes the first segment one tick.
+    /// clears stopped_ and makes the first segment one tick when starting from rest.
     void prepare_profile(uint32_t v_entry2);
     void take_spec(const MoveSpec& spec);
     /// What begin() does after begin_line() or begin_curve(): the speeds and the profile over the
