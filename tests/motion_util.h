@@ -117,6 +117,10 @@ inline std::vector<std::vector<ll::Run>> run_segments(ll::StepGen& gen, const ll
     q.clear();
     if (!gen.begin(spec)) return out;
     while (gen.active()) {
+        // An empty queue from slot 0, as after clear_queue_time(): the generator's horizon
+        // accounting starts there (from any other head it would take the padding's slots for
+        // its own runs, and stop after the first segment).
+        q.clear();
         uint8_t pad = 0;
         while (q.free_slots() > 2 * m) {
             q.push(ll::Run{0, 0, 1, 1});

@@ -127,6 +127,29 @@ TEST(StepGen, CruiseRunsFollowTheSeedWaitTimesAtTheCompensatedSpeed) {
                 worst, 100 * spread);
 }
 
+TEST(StepGen, ShortLinesAtSpeedAreProducedInOneSegmentEach) {
+    // 0.1 mm lines at 50 mm/s, as in the circle of G1 lines (docs/benchmarks.md): 8 reference
+    // ticks of about 4,000 cycles. From rest the first segment is one tick; a line entering at
+    // speed keeps the last segment length, and at cruise a segment lasts up to kSegmentCycles
+    // (8 ticks here), so each further line is a single segment: 6,144-cycle segments made 5.
+    lltest::Machine m{80, 80};
+    ll::StepGen gen{};
+    gen.configure(&m.lengths, 64);
+    auto ticks = [](const std::vector<ll::Run>& seg) {
+        int n = 0;
+        for (const auto& r : seg) n += (r.steps & 1) ? r.count : 0; // X is the reference axis
+        return n;
+    };
+    auto first = lltest::run_segments(gen, m.move({8, 1}, 3000, 1000, 3000, 3000));
+    ASSERT_GE(first.size(), 2u);
+    EXPECT_EQ(ticks(first[0]), 1);
+    for (int32_t dy : {2, 1, 0, 3}) {
+        auto segs = lltest::run_segments(gen, m.move({8, dy}, 3000, 1000, 3000, 3000));
+        ASSERT_EQ(segs.size(), 1u) << "dy " << dy;
+        EXPECT_EQ(ticks(segs[0]), 8);
+    }
+}
+
 TEST(StepGen, MovesEndExactlyOnTheirTargetWithEveryAxisStepCounted) {
     std::mt19937 rng(11);
     lltest::Machine m{80, 80, 400, 40};
