@@ -470,12 +470,12 @@ __attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t
         // tolerance over the segment (docs/motion.md, "Speed accuracy"): a tick u away from the
         // segment's midpoint runs off by u / (2 l), with l = A / s ticks from rest, which the
         // tolerance allows for segments of up to 16 ticks. Measured against it, segments of up to
-        // 8 ticks use about half (l >= 4 L keeps the second-order terms small), 16 ticks all of
-        // it, so 16 and 32 are taken only where the speed is steady: 32 ticks give 8 / l where
+        // 8 ticks no longer than l / 8 use about half, 16 ticks all of it, so 16 and 32 are
+        // taken only where the speed is steady: 32 ticks give 8 / l where
         // 16-tick segments are allowed 4 / l, and 4 / l <= 1 / Delta (the allowance for whole
         // cycles) once l >= 4 Delta; 64 ticks more cover how far A moves until the next segment.
-        // Segments shorter than kMinSegmentCycles are never made: producing one costs about
-        // 3,000 cycles when its speed changes.
+        // Segments shorter than kMinSegmentCycles are made only within 8 L of rest (the speed
+        // falls fast there): producing one costs about 3,000 cycles when its speed changes.
         uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8; // / next: a shift
         uint32_t least = static_cast<uint32_t>(kMinSegmentCycles) << 8;
         const uint32_t l = a >> prof_.log_s; // ticks from rest
@@ -648,7 +648,8 @@ void StepGen::fill_curve(RunQueue& q) {
         // A curve segment costs a chord (a square root) on top of its samples: 8x the line
         // segment duration keeps that cost to a fraction of the time the samples take (one
         // sample when it needs idle waits).
-        seg_len_ = next_segment(period_q8 >> 3, period_q8, 0xFFFFFFFFul);
+        seg_len_ =
+            next_segment(period_q8 >> 3, period_q8, 0xFFFFFFFFul); // no speed limit: <= 3 samples
         if (cv_.w.done()) {
             seg_len_ = 1;
             finish_move();
