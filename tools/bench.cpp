@@ -989,7 +989,11 @@ int run(int argc, char** argv) {
         const int64_t grbl_spread =
             with_grbl ? std::max(-gp.period_err_lo, gp.period_err_hi) : int64_t(12);
         rows.push_back({"Cruise interval jitter at 30 kHz, '?' every 50 ms", jitter_text(polled),
-                        "better than GRBL", g(jitter_text(gp), "±12 cycles"),
+                        "better than GRBL",
+                        g(jitter_text(gp) + fmt("; without serial traffic %+lld / %+lld",
+                                                static_cast<long long>(gq.period_err_lo),
+                                                static_cast<long long>(gq.period_err_hi)),
+                          "±12 cycles"),
                         !polled.gaps && ours_spread < grbl_spread ? "yes" : "no"});
     }
 
