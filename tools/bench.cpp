@@ -404,8 +404,10 @@ RateScan scan_rates(const Fw& fw, int axes, const std::vector<double>& rates, do
         try {
             r = rate_run(fw, axes, rate, mm, false, false);
         } catch (const SimError& e) {
-            // The simulation stopped (with GRBL above 50,000 steps/s: simavr's table of nested
-            // interrupts full, docs/benchmarks.md "GRBL 1.1h reference").
+            // The simulation stopped. GRBL from 50,000 steps/s: its step interrupt clears `busy`
+            // before its epilogue with interrupts on, so once it lasts a period the next one
+            // enters there and runs in full, one level deeper per step, until simavr's table of
+            // nested interrupts is full (docs/benchmarks.md "GRBL 1.1h reference").
             r = RateRun();
             r.requested = rate;
             r.period = kCpu / rate;
@@ -844,7 +846,7 @@ std::string rate_verdict(const RateScan& s) {
     // The first rate at which the simulation stopped (interrupts nested until the stack ran out).
     for (const RateRun& r : s.runs) {
         if (r.crash.empty()) continue;
-        v += "; the simulation stops from " + thousands(r.requested) + " (see the run)";
+        v += "; interrupts nest until the simulation stops from " + thousands(r.requested);
         break;
     }
     return v;
