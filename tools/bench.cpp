@@ -4,6 +4,7 @@
 //   build/host/tools/llbench                 # every figure (about a minute)
 //   build/host/tools/llbench --quick         # a tiny configuration (smoke test)
 //   build/host/tools/llbench --only circle   # one group: rate, isr, circle, size, ceiling
+//   build/host/tools/llbench --grbl /tmp/grbl/grbl_v1.1h.hex  # also GRBL 1.1h, measured alike
 //
 // Nothing here is a pass/fail test: the program prints figures and whether each goal is met,
 // and exits 0 unless a run could not be carried out (firmware missing, no banner, ...).
