@@ -14,6 +14,7 @@ extern "C" {
 #include <avr_eeprom.h>
 #include <avr_ioport.h>
 #include <avr_uart.h>
+#include <sim_hex.h>
 #include <sim_regbit.h>
 }
 
@@ -47,6 +48,28 @@ bool file_exists(const std::string& path) {
     return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
+bool is_hex_image(const std::string& path) {
+    return path.size() > 4 && (path.compare(path.size() - 4, 4, ".hex") == 0 ||
+                               path.compare(path.size() - 4, 4, ".HEX") == 0);
+}
+
+/// An Intel hex image (what avrdude flashes, e.g. a released GRBL build): its data records into
+/// fw->flash from address 0, gaps erased (0xFF). No symbols, no EEPROM.
+void read_hex_image(const std::string& path, elf_firmware_t* fw) {
+    ihex_chunk_p chunks = nullptr;
+    const int n = read_ihex_chunks(path.c_str(), &chunks);
+    if (n <= 0) throw SimError("llsim: cannot read Intel hex " + path);
+    uint32_t end = 0;
+    for (int i = 0; i < n; ++i) end = std::max(end, chunks[i].baseaddr + chunks[i].size);
+    fw->flash = static_cast<uint8_t*>(malloc(end));
+    memset(fw->flash, 0xFF, end);
+    for (int i = 0; i < n; ++i)
+        memcpy(fw->flash + chunks[i].baseaddr, chunks[i].data, chunks[i].size);
+    fw->flashsize = end;
+    fw->flashbase = 0;
+    free_ihex_chunks(chunks);
+}
+
 } // namespace
 
 Sim::Sim(const Options& opt) : opt_(opt) {
@@ -54,7 +77,9 @@ Sim::Sim(const Options& opt) : opt_(opt) {
     if (!file_exists(opt_.elf)) throw SimError("llsim: firmware not found: " + opt_.elf);
     g_log_level = opt_.log_level;
     avr_global_logger_set(&logger);
-    if (elf_read_firmware(opt_.elf.c_str(), &fw_) != 0)
+    if (is_hex_image(opt_.elf))
+        read_hex_image(opt_.elf, &fw_);
+    else if (elf_read_firmware(opt_.elf.c_str(), &fw_) != 0)
         throw SimError("llsim: cannot read ELF " + opt_.elf);
     // The board is fixed: an Uno. An .mmcu section in the ELF cannot change that.
     snprintf(fw_.mmcu, sizeof fw_.mmcu, "%s", kMcu);

@@ -49,8 +49,8 @@ struct SimError : std::runtime_error {
 };
 
 struct Options {
-    std::string elf;                                    ///< firmware image (ELF for avr-gcc)
-    Corrections corrections = Corrections::all();       ///< datasheet corrections, all on
+    std::string elf;                              ///< firmware image: ELF, or Intel hex (*.hex)
+    Corrections corrections = Corrections::all(); ///< datasheet corrections, all on
     std::vector<Signal> signals = cnc_shield_signals(); ///< pins whose edges are recorded
     std::string eeprom_file; ///< raw 1024-byte image loaded at start ("" = blank 0xFF chip)
     /// simavr's own log messages printed to stderr up to this level (LOG_ERROR = 2, ...).

@@ -289,6 +289,44 @@ bool StackProbe::overflowed() const {
     return sim_.peek(static_cast<uint16_t>(bss_end_)) != kPaint;
 }
 
+CompareLog::CompareLog(Sim& sim, uint8_t vector, char timer) : sim_(sim) {
+    avr_t* a = sim.avr();
+    for (int i = 0; i < a->interrupts.vector_count; ++i) {
+        avr_int_vector_t* v = a->interrupts.vector[i];
+        if (v && v->vector == vector) irq_ = &v->irq[AVR_INT_IRQ_PENDING];
+    }
+    for (avr_io_t* io = a->io_port; io; io = io->next) {
+        if (strcmp(io->kind, "timer") != 0) continue;
+        avr_timer_t* t = reinterpret_cast<avr_timer_t*>(io);
+        if (t->name == timer) timer_ = t;
+    }
+    if (!irq_ || !timer_) throw std::runtime_error("CompareLog: no such vector or timer");
+    avr_irq_register_notify(irq_, &CompareLog::on_pending, this);
+}
+
+CompareLog::~CompareLog() {
+    avr_irq_unregister_notify(irq_, &CompareLog::on_pending, this);
+}
+
+void CompareLog::on_pending(avr_irq_t*, uint32_t value, void* param) {
+    if (!value) return; // cleared (served, or written one to clear)
+    CompareLog* self = static_cast<CompareLog*>(param);
+    const avr_t* a = self->sim_.avr();
+    uint64_t at = a->cycle;
+    // The flag is set at the period boundary; simavr notices it after the instruction under way
+    // (at most 4 cycles later), with tov_base holding the boundary itself.
+    const uint64_t base = self->timer_->tov_base;
+    if (self->timer_->tov_cycles > 1 && base <= at && at - base <= 8) at = base;
+    self->matches_.push_back(at);
+}
+
+bool CompareLog::latest_at(uint64_t cycle, uint64_t* match) const {
+    auto it = std::upper_bound(matches_.begin(), matches_.end(), cycle);
+    if (it == matches_.begin()) return false;
+    *match = *(it - 1);
+    return true;
+}
+
 uint32_t peek_var(const Sim& sim, const std::string& symbol, unsigned bytes, unsigned offset) {
     const uint32_t addr = sim.symbol(symbol) + offset;
     uint32_t v = 0;

@@ -14,6 +14,10 @@
 #include "grbl_client.h"
 #include "harness.h"
 
+extern "C" {
+#include <avr_timer.h>
+}
+
 namespace ll {
 namespace tools {
 
@@ -142,6 +146,31 @@ class StackProbe {
     const sim::Sim& sim_;
     unsigned bss_end_;
     unsigned painted_to_;
+};
+
+/// Cycles at which a timer's compare flag is set (Timer1 COMPA by default: the moment the step
+/// timer asks for the next step, in our firmware and in GRBL alike). Recorded from simavr's
+/// "interrupt pending" signal of the vector, so it works without symbols (a GRBL .hex) and
+/// whatever sets the flag (simavr's timer or the harness's corrections). In CTC mode simavr sets
+/// the flag from its period boundary, `tov_base`, which is then the exact match cycle; the
+/// signal itself comes at the end of the instruction under way.
+class CompareLog {
+  public:
+    explicit CompareLog(sim::Sim& sim, uint8_t vector = 11, char timer = '1');
+    ~CompareLog();
+    CompareLog(const CompareLog&) = delete;
+    CompareLog& operator=(const CompareLog&) = delete;
+
+    const std::vector<uint64_t>& matches() const { return matches_; }
+    /// The latest match at or before `cycle`; false when there is none.
+    bool latest_at(uint64_t cycle, uint64_t* match) const;
+
+  private:
+    static void on_pending(avr_irq_t* irq, uint32_t value, void* param);
+    sim::Sim& sim_;
+    avr_irq_t* irq_ = nullptr;
+    avr_timer_t* timer_ = nullptr;
+    std::vector<uint64_t> matches_;
 };
 
 /// A data-space variable of the firmware by symbol (little endian, up to 4 bytes).
