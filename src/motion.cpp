@@ -128,7 +128,6 @@ bool push_line(const LineRequest& req) {
     // (Idle means nothing queued: a move dropped for its zero length leaves it idle.)
     if (m.planner.add(req.target_steps, req.target_um, feed, req.curve) && m.state == State::Idle)
         m.state = State::Cycle;
-    poll();
     return true;
 }
 

@@ -238,6 +238,8 @@ TEST_F(Protocol, SoftResetFlushesInputAndResetsTheParserNotTheSettings) {
 TEST_F(Protocol, SoftResetDuringMotionRaisesAlarm3) {
     d.send("G1 X50 F100\n");
     d.run_until_responses(1);
+    // The `ok` comes as soon as the move is planned; its steps start at the next poll.
+    EXPECT_EQ(d.run_for(kMs), "");
     if (ll::motion::state() == ll::motion::State::Idle) {
         GTEST_SKIP() << "this motion completes instantly (motion stub)";
     }
@@ -246,6 +248,21 @@ TEST_F(Protocol, SoftResetDuringMotionRaisesAlarm3) {
               std::string("ALARM:3\r\n") + kBanner + "[MSG:'$H'|'$X' to unlock]\r\n");
     EXPECT_EQ(d.command("G0 X0"), "error:9\r\n");
     EXPECT_EQ(d.command("$X"), "[MSG:Caution: Unlocked]\r\nok\r\n");
+}
+
+TEST_F(Protocol, SoftResetBeforeTheFirstStepDropsTheMoveWithoutAlarm) {
+    // The `ok` comes once the move is planned, before its first step: a reset then loses no
+    // position (nothing moved), so it drops the move without ALARM:3, as GRBL does when its
+    // cycle has not started.
+    d.send("G1 X50 F100\n");
+    d.run_until_responses(1);
+    if (ll::motion::state() == ll::motion::State::Idle) {
+        GTEST_SKIP() << "this motion completes instantly (motion stub)";
+    }
+    d.send("\x18");
+    EXPECT_EQ(d.run_for(kMs), std::string(kBanner));
+    EXPECT_EQ(steps(0), 0);
+    EXPECT_EQ(d.command("G0 X0"), "ok\r\n"); // not locked
 }
 
 TEST_F(Protocol, AlarmLocksGcodeUntilUnlocked) {
