@@ -471,7 +471,7 @@ const FnList kPlannerFns = {
     {"_ZN2ll3num5parseEPKcRhRNS0_7DecimalE", "num::parse"},
     {"_ZN2ll5gcode11um_to_stepsEhlRl", "gcode::um_to_steps"},
     {"_ZN2ll6motion9push_lineERKNS0_11LineRequestE", "motion::push_line"},
-    {"_ZN2ll7Planner3addEPKlS2_mb", "Planner::add"},
+    {"_ZN2ll7Planner3addEPKlS2_mPKNS_11CurveParamsE", "Planner::add"},
     {"_ZN2ll11move_limitsERKNS_7MachineEPKlhRNS_10MoveLimitsE", "move_limits"},
     {"_ZNK2ll7Planner9junction2EPKl", "Planner::junction2"},
     {"_ZN2ll7Planner11recalculateEv", "Planner::recalculate"},
@@ -551,7 +551,7 @@ CircleRun circle_run(const Fw& fw, double radius, bool send_and_wait, bool profi
     c.lines = job.size();
     std::unique_ptr<Profiler> prof;
     const std::string kExecute = "_ZN2ll5gcode7executeEPKchRNS0_7OutcomeE";
-    const std::string kAdd = "_ZN2ll7Planner3addEPKlS2_mb";
+    const std::string kAdd = "_ZN2ll7Planner3addEPKlS2_mPKNS_11CurveParamsE";
     const std::string kPushLine = "_ZN2ll6motion9push_lineERKNS0_11LineRequestE";
     if (profile) {
         std::vector<std::string> syms;
