@@ -99,10 +99,20 @@ uint32_t curve_accel(const Machine& m, uint8_t plane, const int32_t delta[kAxes]
     return at_least_1(Num(acc).mulc(k3_6, k3_6e).u32()); // units/s^2 x1000 -> units/min^2
 }
 
-// Squared speed of a feed (units/min x1000), (units/min)^2.
-uint32_t speed2_of(uint32_t feed) {
-    Num v(feed);
-    return v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
+// Squared speed of a feed (units/min x1000), (units/min)^2. The last one is kept: a job's moves
+// mostly share their feed, and each line asks twice (its junction, then its profile), 560
+// cycles each on the chip.
+uint32_t g_last_speed2[2]; // feed, its v^2 (feed 0: v^2 0, right from the start)
+
+__attribute__((noinline)) uint32_t speed2_of(uint32_t feed) {
+    uint32_t* last = g_last_speed2;
+    asm("" : "+r"(last)); // through a pointer register (ld/st), not 4-byte lds/sts
+    if (feed != last[0]) {
+        last[0] = feed;
+        Num v(feed);
+        last[1] = v.mul(v).mulc(kMicro, -51).u32(); // x 1e-6
+    }
+    return last[1];
 }
 
 // A curve's end tangent (u, v, w; w only when `n` is 3) as a machine-axis vector. The axes of
