@@ -663,7 +663,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         if (b.words & bit(kWordP)) { // LinuxCNC: P turns, P1 the plain arc
             uint32_t turns;
             if (!num::to_uint(b.v[kWordP].d, 256u, turns)) return kCommandValueNotInteger;
-            if (turns == 0) return kInvalidTarget;
+            // (turns <= 256: its low 16 bits are zero only when it is)
+            if (static_cast<uint16_t>(turns) == 0) return kInvalidTarget;
             c.turns = static_cast<uint8_t>(turns - 1);
         }
     }
