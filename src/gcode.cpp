@@ -931,12 +931,14 @@ namespace {
 __attribute__((noinline)) void convert_axes(const int32_t* from, int32_t* to, bool to_um) {
     const AxisSettings* s = g_settings.axis;
     for (uint8_t a = kAxes; a != 0; --a, ++to) {
-        uint32_t spu = (s++)->steps_per_unit;
-        int32_t v;
-        if (num::mul_div_round(*from++, to_um ? 1000000u : spu, to_um ? spu : 1000000u, v) ||
-            to_um) {
-            *to = v;
+        uint32_t mul = (s++)->steps_per_unit, div = 1000000u;
+        if (to_um) {
+            div = mul;
+            mul = 1000000u;
         }
+        // Written in place (no frame for the result), the old value put back when it is kept.
+        int32_t old = *to;
+        if (!num::mul_div_round(*from++, mul, div, *to) && !to_um) *to = old;
     }
 }
 } // namespace
