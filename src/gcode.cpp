@@ -980,7 +980,7 @@ void report_modes() {
     out::rate(g_state.feed);
     out::str(LL_PSTR(" S"));
     out::u32(g_state.spindle_speed);
-    out::line(LL_PSTR("]"));
+    out::bracket_eol();
 }
 
 void report_offsets() {
@@ -992,7 +992,7 @@ void report_offsets() {
         out::u8(code);
         out::ch(':');
         out::coords(code == 54 ? g_state.g54 : code == 92 ? g_state.g92 : nullptr);
-        out::line(LL_PSTR("]"));
+        out::bracket_eol();
     }
     out::str(LL_PSTR("[TLO:"));
     out::coord(0);
