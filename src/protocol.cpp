@@ -244,7 +244,8 @@ __attribute__((noinline)) uint8_t system_command() {
                              "]\r\n[OPT:I,16,"));
             out::u8(p.rx_capacity);
             // The curve extensions (docs/curves.md), as a message senders show as it is.
-            out::line(LL_PSTR("]\r\n[MSG:G2.1/G3.1 ellipse IJ=centre PQ=semi-axes, G5 Bezier]"));
+            out::bracket_eol();
+            out::msg(LL_PSTR("G2.1/G3.1 ellipse IJ=centre PQ=semi-axes, G5 Bezier"));
         }
         return kOk;
     }
