@@ -410,7 +410,11 @@ bool idle() {
 namespace app {
 
 void init() {
+#if !defined(__AVR__)
+    // On the chip p is in .bss, which the start-up code has cleared: main() calls init() once,
+    // right after it. The host tests boot again and again.
     memset(&p, 0, sizeof(p));
+#endif
     p.rx_capacity = hal::serial_rx_free(); // the buffer is empty at power-up
     if (!settings::load()) {
         // GRBL 1.1h: error:7 ("EEPROM read fail. Using defaults"), then the restored settings.
