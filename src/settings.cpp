@@ -97,8 +97,7 @@ Found find(uint8_t n) {
 // Writes v at addr and returns it, or (write false) returns the byte at addr.
 __attribute__((noinline)) uint8_t transfer(uint16_t addr, uint8_t v, bool write) {
     if (!write) return hal::eeprom_read(addr);
-    hal::eeprom_write(addr, v);
-    return v;
+    return hal::eeprom_write(addr, v);
 }
 
 bool record(uint16_t addr, void* data, uint8_t n, bool write) {
