@@ -8,19 +8,6 @@
 #include "lowlevel/settings.h"
 
 namespace ll {
-namespace fw {
-
-void board_init() {
-    // Step and direction outputs start low; stepper_configure() applies $2. Enable starts at
-    // "disabled" for $4 = 0 (high) until stepper_configure() and motion set it properly; limit
-    // inputs get their pull-ups. Plain writes: the ports hold their reset value 0 (main.cpp).
-    DDRD = static_cast<uint8_t>(board::kStepMaskD | board::kDirMaskD);
-    PORTB = static_cast<uint8_t>(board::Enable::kMask | board::kLimitMaskB);
-    DDRB = static_cast<uint8_t>(board::kStepMaskB | board::kDirMaskB | board::Enable::kMask);
-}
-
-} // namespace fw
-
 namespace hal {
 
 uint8_t limits() {

@@ -49,18 +49,6 @@ ISR(TIMER0_COMPA_vect, ISR_NAKED) {
 }
 
 namespace ll {
-namespace fw {
-
-void clock_init() {
-    // TCNT0 and the flags keep their reset value 0 (main.cpp).
-    TCCR0A = _BV(WGM01); // CTC
-    OCR0A = 249;         // 250 ticks of 4 µs
-    TIMSK0 = _BV(OCIE0A);
-    TCCR0B = _BV(CS01) | _BV(CS00); // clk/64
-}
-
-} // namespace fw
-
 namespace hal {
 
 uint32_t millis() {

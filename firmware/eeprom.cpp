@@ -20,13 +20,16 @@ __attribute__((noinline)) uint8_t eeprom_read(uint16_t addr) {
     return EEDR;
 }
 
-void eeprom_write(uint16_t addr, uint8_t value) {
+uint8_t eeprom_write(uint16_t addr, uint8_t value) {
     // Leaves EEAR at addr and the previous write finished.
-    if (eeprom_read(addr) == value) return;
+    if (eeprom_read(addr) == value) return value;
     EEDR = value;
-    fw::IrqGuard g;
-    EECR = _BV(EEMPE); // erase and write in one operation (EEPM = 0)
-    EECR |= _BV(EEPE);
+    {
+        fw::IrqGuard g;
+        EECR = _BV(EEMPE); // erase and write in one operation (EEPM = 0)
+        EECR |= _BV(EEPE);
+    }
+    return value; // (the caller's transfer() returns it: no register kept for it there)
 }
 
 } // namespace hal

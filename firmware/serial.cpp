@@ -21,8 +21,7 @@
 namespace ll {
 namespace {
 
-constexpr uint8_t kUbrr = 16; // 16 MHz / (8 * (16 + 1)) = 117647 baud, +2.1 % (as GRBL)
-constexpr uint8_t kUcsr0bRun = _BV(RXCIE0) | _BV(TXCIE0) | _BV(RXEN0) | _BV(TXEN0);
+using fw::kUcsr0bRun;
 constexpr uint8_t kUcsr0bRxMasked = _BV(TXCIE0) | _BV(RXEN0) | _BV(TXEN0);
 
 // Receive ring: 128 bytes, all usable (senders' character counting sends 128 bytes
@@ -141,17 +140,6 @@ ISR(USART_TX_vect, ISR_NAKED) {
 }
 
 namespace ll {
-namespace fw {
-
-void serial_init() {
-    // UBRR0H (0) and UCSR0C (8N1) keep their reset values (main.cpp).
-    UBRR0L = kUbrr;
-    UCSR0A = _BV(U2X0);
-    UCSR0B = kUcsr0bRun;
-}
-
-} // namespace fw
-
 namespace hal {
 
 bool serial_get(uint8_t& byte) {

@@ -247,19 +247,6 @@ ISR(TIMER1_COMPB_vect, ISR_NAKED) {
 }
 
 namespace ll {
-namespace fw {
-
-void stepper_init() {
-    // TCCR1A, TCCR1B (no clock: stopped) and GPIOR0 keep their reset value 0 (main.cpp).
-    TIMSK1 = _BV(OCIE1A) | _BV(OCIE1B); // the timer only runs while there are runs
-    // The pulse width, the guard period and the pin polarities come from stepper_configure(),
-    // which app::init() calls (motion::settings_changed()) before any run can start (llbench
-    // sends the bench app a `C` first). stepper_enable(false) here would repeat board_init()'s
-    // level (s_enable_invert is still 0).
-}
-
-} // namespace fw
-
 namespace hal {
 
 void stepper_configure(const StepperConfig& cfg) {

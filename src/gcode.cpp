@@ -663,7 +663,8 @@ __attribute__((noinline)) uint8_t check_curve(Block& b, Motion motion, uint8_t a
         if (b.words & bit(kWordP)) { // LinuxCNC: P turns, P1 the plain arc
             uint32_t turns;
             if (!num::to_uint(b.v[kWordP].d, 256u, turns)) return kCommandValueNotInteger;
-            if (turns == 0) return kInvalidTarget;
+            // (turns <= 256: its low 16 bits are zero only when it is)
+            if (static_cast<uint16_t>(turns) == 0) return kInvalidTarget;
             c.turns = static_cast<uint8_t>(turns - 1);
         }
     }
@@ -930,12 +931,14 @@ namespace {
 __attribute__((noinline)) void convert_axes(const int32_t* from, int32_t* to, bool to_um) {
     const AxisSettings* s = g_settings.axis;
     for (uint8_t a = kAxes; a != 0; --a, ++to) {
-        uint32_t spu = (s++)->steps_per_unit;
-        int32_t v;
-        if (num::mul_div_round(*from++, to_um ? 1000000u : spu, to_um ? spu : 1000000u, v) ||
-            to_um) {
-            *to = v;
+        uint32_t mul = (s++)->steps_per_unit, div = 1000000u;
+        if (to_um) {
+            div = mul;
+            mul = 1000000u;
         }
+        // Written in place (no frame for the result), the old value put back when it is kept.
+        int32_t old = *to;
+        if (!num::mul_div_round(*from++, mul, div, *to) && !to_um) *to = old;
     }
 }
 } // namespace
@@ -977,7 +980,7 @@ void report_modes() {
     out::rate(g_state.feed);
     out::str(LL_PSTR(" S"));
     out::u32(g_state.spindle_speed);
-    out::line(LL_PSTR("]"));
+    out::bracket_eol();
 }
 
 void report_offsets() {
@@ -989,7 +992,7 @@ void report_offsets() {
         out::u8(code);
         out::ch(':');
         out::coords(code == 54 ? g_state.g54 : code == 92 ? g_state.g92 : nullptr);
-        out::line(LL_PSTR("]"));
+        out::bracket_eol();
     }
     out::str(LL_PSTR("[TLO:"));
     out::coord(0);

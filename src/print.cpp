@@ -66,6 +66,10 @@ void line(const FlashChar* s) {
     eol();
 }
 
+void bracket_eol() {
+    line(LL_PSTR("]"));
+}
+
 void u32(uint32_t v) {
     digits(v, 0);
 }
@@ -131,7 +135,7 @@ void status(uint8_t code) {
 void msg(const FlashChar* text) {
     str(LL_PSTR("[MSG:"));
     str(text);
-    line(LL_PSTR("]"));
+    bracket_eol();
 }
 
 } // namespace out

@@ -244,7 +244,8 @@ __attribute__((noinline)) uint8_t system_command() {
                              "]\r\n[OPT:I,16,"));
             out::u8(p.rx_capacity);
             // The curve extensions (docs/curves.md), as a message senders show as it is.
-            out::line(LL_PSTR("]\r\n[MSG:G2.1/G3.1 ellipse IJ=centre PQ=semi-axes, G5 Bezier]"));
+            out::bracket_eol();
+            out::msg(LL_PSTR("G2.1/G3.1 ellipse IJ=centre PQ=semi-axes, G5 Bezier"));
         }
         return kOk;
     }
@@ -409,7 +410,11 @@ bool idle() {
 namespace app {
 
 void init() {
+#if !defined(__AVR__)
+    // On the chip p is in .bss, which the start-up code has cleared: main() calls init() once,
+    // right after it. The host tests boot again and again.
     memset(&p, 0, sizeof(p));
+#endif
     p.rx_capacity = hal::serial_rx_free(); // the buffer is empty at power-up
     if (!settings::load()) {
         // GRBL 1.1h: error:7 ("EEPROM read fail. Using defaults"), then the restored settings.

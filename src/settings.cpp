@@ -97,8 +97,7 @@ Found find(uint8_t n) {
 // Writes v at addr and returns it, or (write false) returns the byte at addr.
 __attribute__((noinline)) uint8_t transfer(uint16_t addr, uint8_t v, bool write) {
     if (!write) return hal::eeprom_read(addr);
-    hal::eeprom_write(addr, v);
-    return v;
+    return hal::eeprom_write(addr, v);
 }
 
 bool record(uint16_t addr, void* data, uint8_t n, bool write) {
@@ -157,13 +156,19 @@ void restore_defaults() {
     clear_coord();
 }
 
+namespace {
+// um zeroed, and saved as the G54 record (for clear_coord() and load_coord()).
+__attribute__((noinline)) void zero_coord(int32_t (&um)[kAxes]) {
+    memset(um, 0, sizeof(um));
+    save_coord(um);
+}
+} // namespace
+
 void clear_coord() {
     // The zeros in the scratch RAM (scratch.h; motion.h says when it is free: `$RST` and app::init
     // only), not in a 16-byte frame.
     using Coords = int32_t[kAxes];
-    Coords& zero = scratch<Coords>();
-    memset(zero, 0, sizeof(zero));
-    save_coord(zero);
+    zero_coord(scratch<Coords>());
 }
 
 bool load() {
@@ -177,8 +182,7 @@ bool load() {
 
 bool load_coord(int32_t (&um)[kAxes]) {
     if (record(kEepromCoordAddr, um, sizeof(um), false)) return true;
-    memset(um, 0, sizeof(um));
-    save_coord(um);
+    zero_coord(um);
     return false;
 }
 

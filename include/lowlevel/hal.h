@@ -54,8 +54,8 @@ uint32_t millis();
 // ---- non-volatile storage -----------------------------------------------------------------
 
 uint8_t eeprom_read(uint16_t addr);
-/// Writes one byte (skips the write when the byte already holds `value`).
-void eeprom_write(uint16_t addr, uint8_t value);
+/// Writes one byte (skips the write when the byte already holds `value`). Returns `value`.
+uint8_t eeprom_write(uint16_t addr, uint8_t value);
 constexpr uint16_t kEepromSize = 1024;
 
 // ---- inputs -------------------------------------------------------------------------------

@@ -22,6 +22,8 @@ void str(const FlashChar* s);
 void eol();
 /// A string kept in flash, then the line end.
 void line(const FlashChar* s);
+/// "]" and the line end: the end of every bracketed message (one string for all of them).
+void bracket_eol();
 /// An unsigned integer in decimal.
 void u32(uint32_t v);
 /// The same for a byte (a shorter call).

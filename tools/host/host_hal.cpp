@@ -259,8 +259,9 @@ uint32_t millis() {
 uint8_t eeprom_read(uint16_t addr) {
     return host::m().eeprom[addr % kEepromSize];
 }
-void eeprom_write(uint16_t addr, uint8_t value) {
+uint8_t eeprom_write(uint16_t addr, uint8_t value) {
     host::m().eeprom[addr % kEepromSize] = value;
+    return value;
 }
 
 uint8_t limits() {
