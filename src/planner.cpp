@@ -258,6 +258,16 @@ bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) 
 // its result in the free slot, and add() fills the slot with the curve once the shape is used.
 // A line and a curve share the block, the last target, the junction and the look-ahead passes;
 // only their limits and end directions differ.
+// A line's length for spec_of_first(), when CurveSlot::lens can keep it.
+__attribute__((noinline)) void Planner::keep_len(PlanBlock& b, uint32_t len) {
+    uint8_t keep = 0;
+    if ((curve_used_ | static_cast<uint16_t>(len >> 16)) == 0) {
+        curves_[1].lens[index(count_)] = static_cast<uint16_t>(len);
+        keep = 1;
+    }
+    b.has_len = keep & 1;
+}
+
 bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], uint32_t feed,
                   const CurveParams* curve) {
     const Machine& m = *m_; // loaded once
@@ -306,6 +316,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
             // 2 a L in (units/min)^2: 2 * accel * len_q8 / 256000. Num::mul() keeps the top 32
             // bits of the exact product, as num64(mul_wide()) would.
             b.dv2 = Num(lim.len_q8).mul(lim.accel).mulc(kMilli, -48).u32();
+            keep_len(b, lim.len_q8);
             feed = min32(feed, lim.vmax); // a rapid's 2^32 - 1 comes out as vmax
         }
         // Unit vector of the commanded move (Q29) on the regulated axes, for the junction: |du|
@@ -330,7 +341,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         }
     }
     memcpy(last_um_, target_um, sizeof(last_um_));
-    b.group = group & 0x3F;
+    b.group = group & 0x3F; // (has_len: a curve's is not read)
     b.curve = slot & 3;
     b.feed = at_least_1(feed);
     // From rest after no queued move or one of another group; else the junction, within
@@ -416,6 +427,8 @@ void Planner::spec_of_first(MoveSpec& s) const {
         const CurveSlot& c = b->curve == 1 ? curves_[0] : curves_[1];
         s.curve = &c.queued.params;
         s.len_q8 = c.queued.len_q8;
+    } else if (b->has_len && curve_used_ == 0) {
+        s.len_q8 = curves_[1].lens[head_]; // add()'s, kept
     } else {
         // The length add() had: the same deltas, group and settings (they only change while
         // nothing is queued).

@@ -19,7 +19,8 @@ namespace ll {
 
 /// Curves queued at once (each keeps its geometry in a slot: RAM is the limit).
 constexpr uint8_t kCurveSlots = 2;
-static_assert(kAxes <= 6 && kCurveSlots <= 3, "a block's group and curve share one byte");
+static_assert(kAxes <= 6 && kCurveSlots <= 3,
+              "a block's group, length flag and curve share one byte");
 
 /// The bit of the normal axis of a curve's plane (axis 2 - plane): 4 >> plane without a shift
 /// loop.
@@ -28,9 +29,10 @@ inline uint8_t normal_bit(uint8_t plane) {
 }
 
 struct PlanBlock {
-    uint8_t delta[kAxes][3]; ///< steps per machine axis, signed 24-bit little-endian
-    uint8_t group : 6;       ///< regulated axes (seed §3.1)
-    uint8_t curve : 2;       ///< 0: a straight move; else 1 + the slot of its curve
+    uint8_t delta[kAxes][3];            ///< steps per machine axis, signed 24-bit little-endian
+    uint8_t group : kAxes <= 5 ? 5 : 6; ///< regulated axes (seed §3.1)
+    uint8_t has_len : 1;                ///< its length is kept (Planner::CurveSlot::lens)
+    uint8_t curve : 2;                  ///< 0: a straight move; else 1 + the slot of its curve
     // dv2, feed, v_entry2: in MoveSpec's order (spec_of_first() copies them at once).
     uint32_t dv2;          ///< 2 a L: squared speed gained or shed over the move, (units/min)^2
     uint32_t feed;         ///< nominal speed, units/min x1000
@@ -133,6 +135,8 @@ class Planner {
     /// the early outs return `limit` itself).
     uint32_t junction2(const int32_t unit[kAxes], uint32_t limit) const;
 
+    /// Keeps a line's length `len` (µm x 256) for spec_of_first() when it can (sets b.has_len).
+    void keep_len(PlanBlock& b, uint32_t len);
     /// Writes the move from the last target to `target` (steps) into `b` and `d`; `target`
     /// becomes the last target. Returns false when no axis moves.
     bool open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]);
@@ -151,9 +155,16 @@ class Planner {
     union CurveSlot {
         ShapedCurve shaped;
         QueuedCurve queued;
+        /// Slot 1, while no curve is queued: the lengths of the queued lines below 2^16 (µm x
+        /// 256: 256 µm), by ring index, for spec_of_first() (a chain of short lines spares a
+        /// travel() per move, for no RAM). A block's has_len says its length is kept: it was
+        /// written while no curve was queued, and holds while none is. (Slot 1 takes a curve
+        /// only while slot 0 holds one, queued after every line kept before it.)
+        uint16_t lens[kPlannerSize];
     };
     static_assert(offsetof(CurveShape, len_q8) == 0 && sizeof(ShapedCurve) <= sizeof(QueuedCurve),
                   "the shape costs no RAM");
+    static_assert(sizeof(CurveSlot::lens) <= sizeof(QueuedCurve), "the lengths cost no RAM");
     /// The free slot (there is one): with two slots, slot 1 when slot 0 is taken.
     uint8_t free_slot_index() const {
         static_assert(kCurveSlots == 2, "one free slot out of two");
