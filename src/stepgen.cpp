@@ -476,17 +476,20 @@ __attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t
         // cycles) once l >= 4 Delta; 64 ticks more cover how far A moves until the next segment.
         // Segments shorter than kMinSegmentCycles are made only within 8 L of rest (the speed
         // falls fast there): producing one costs about 3,000 cycles when its speed changes.
-        uint32_t target = static_cast<uint32_t>(kSegmentCycles) << 8; // / next: a shift
-        uint32_t least = static_cast<uint32_t>(kMinSegmentCycles) << 8;
+        // The segment's duration, delta x next (cycles x 256), against the two constants: one
+        // shift a doubling (it stays below 2^24: no overflow).
+        constexpr uint32_t kTarget = static_cast<uint32_t>(kSegmentCycles) << 8;
+        constexpr uint32_t kLeast = static_cast<uint32_t>(kMinSegmentCycles) << 8;
         const uint32_t l = a >> prof_.log_s; // ticks from rest
         const bool steady = l >= (longest >> 6) + 64;
-        while (next < 16 && delta < target) {
-            if (!(next < 8 ? l >= 16u * next : steady) && (delta >= least || l < 8u * next)) break;
+        uint8_t need = 16; // l wanted for a doubling below 8 ticks: 16 next
+        while (next < 16 && delta < kTarget) {
+            if (!(next < 8 ? l >= need : steady) && (delta >= kLeast || l < need / 2u)) break;
             next = static_cast<uint8_t>(next << 1);
-            target >>= 1;
-            least >>= 1;
+            delta <<= 1;
+            need = static_cast<uint8_t>(need << 1);
         }
-        if (next == 16 && delta < least && steady) next = kMaxSegmentTicks;
+        if (next == 16 && delta < kLeast && steady) next = kMaxSegmentTicks;
     }
     return next;
 }
