@@ -5,6 +5,7 @@
 #include <random>
 
 #include "lowlevel/planner.h"
+#include "lowlevel/stepgen.h"
 
 namespace {
 
@@ -161,6 +162,61 @@ TEST(Planner, SixteenShortMovesNeverAskForAnImpossibleDeceleration) {
         }
         EXPECT_EQ(blocks.front().v_entry2, 0u);
     }
+}
+
+TEST(Planner, EveryLineHandsOverItsExactLengthWhetherKeptOrMeasuredAgain) {
+    // spec_of_first() takes a short line's length from where add() kept it (curve slot 1's RAM,
+    // while no curve is queued) or measures it again: either way it must be move_limits()'s.
+    // Random queues of short and long lines and semicircles (which borrow that RAM), consumed
+    // as a running machine would, between the adds.
+    std::mt19937 rng(21);
+    size_t lines = 0;
+    for (int round = 0; round < 40; ++round) {
+        Fixture f;
+        double x = 0, y = 0;
+        for (int step = 0; step < 300; ++step) {
+            const unsigned r = rng() % 10;
+            if (r < 4 && !f.p.empty()) {
+                ll::MoveSpec s{};
+                f.p.spec_of_first(s);
+                if (!s.curve) {
+                    ll::MoveLimits lim;
+                    ll::move_limits(f.m, s.delta, s.group, lim);
+                    ASSERT_EQ(s.len_q8, lim.len_q8) << "round " << round << " step " << step;
+                    ++lines;
+                }
+                f.p.discard_first();
+            } else if (r < 6 && !f.p.full() && f.p.curve_slot_free()) {
+                // A semicircle of radius 1 mm along +X (G2), centre 1 mm ahead.
+                const double nx = x + 2;
+                ll::CurveParams c{};
+                c.kind = ll::kCurveArc;
+                c.clockwise = 1;
+                c.start_um[0] = static_cast<int32_t>(std::lround(x * 1000));
+                c.start_um[1] = static_cast<int32_t>(std::lround(y * 1000));
+                c.end_um[0] = static_cast<int32_t>(std::lround(nx * 1000));
+                c.end_um[1] = c.start_um[1];
+                c.a_um[0] = c.start_um[0] + 1000;
+                c.a_um[1] = c.start_um[1];
+                c.b_um[0] = c.b_um[1] = 1000;
+                int32_t t[ll::kAxes] = {static_cast<int32_t>(std::lround(nx * 80)),
+                                        static_cast<int32_t>(std::lround(y * 80)), 0, 0};
+                int32_t um[ll::kAxes] = {c.end_um[0], c.end_um[1], 0, 0};
+                if (f.p.shape_curve(um, c)) {
+                    f.p.add(t, um, 3000000, &c);
+                    x = nx;
+                }
+            } else if (!f.p.full()) {
+                // Mostly 0.1 mm chords (kept), sometimes a 2 mm line (measured again).
+                const double len = rng() % 4 ? 0.1 : 2.0;
+                const double th = (rng() % 628) / 100.0;
+                x += len * std::cos(th);
+                y += len * std::sin(th);
+                f.add_mm(x, y, 3000);
+            }
+        }
+    }
+    EXPECT_GT(lines, 3000u);
 }
 
 TEST(Planner, EachAxisKeepsItsOwnRateAndAcceleration) {
