@@ -461,7 +461,9 @@ asm(".section .text._ZN2ll5num64Emma,\"ax\",@progbits\n"
 
 // uint32_t div32_16(uint32_t n, uint16_t d): n in r22..r25, d in r20:r21; the quotient in
 // r22..r25. Restoring division: n shifts into a 16-bit remainder (its 17th bit in the carry)
-// and the quotient bits into the room n leaves.
+// and the quotient bits into the room n leaves. When n's top byte is below d (quotients below
+// 2^24, as the step generator's), the first 8 turns only move it into the remainder: done by
+// byte moves (104 cycles less).
 asm(".section .text._ZN2ll8div32_16Emj,\"ax\",@progbits\n"
     ".global _ZN2ll8div32_16Emj\n"
     ".type _ZN2ll8div32_16Emj, @function\n"
@@ -469,6 +471,15 @@ asm(".section .text._ZN2ll8div32_16Emj,\"ax\",@progbits\n"
     "clr  r26\n"
     "clr  r27\n"
     "ldi  r30, 32\n"
+    "cp   r25, r20\n"
+    "cpc  r1, r21\n"
+    "brsh 1f\n"
+    "mov  r26, r25\n"
+    "mov  r25, r24\n"
+    "mov  r24, r23\n"
+    "mov  r23, r22\n"
+    "clr  r22\n"
+    "ldi  r30, 24\n"
     "1:\n"
     "lsl  r22\n"
     "rol  r23\n"
@@ -751,48 +762,29 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "movw r24, r20\n"
     "ret\n"
     ".size _ZN2ll7mul_shrEmmh, .-_ZN2ll7mul_shrEmmh\n"
-    // uint32_t Num::u32() const: floor(m 2^e), saturated; whole bytes first, then bits (zero and
-    // saturation from Num::of).
+    // uint32_t Num::u32() const: floor(m 2^e), saturated: m >> -e by .Lshr_sat (e <= -32 gives
+    // zero there; saturation from Num::of).
     ".global _ZNK2ll3Num3u32Ev\n"
     ".type _ZNK2ll3Num3u32Ev, @function\n"
     "_ZNK2ll3Num3u32Ev:\n"
     "movw r30, r24\n"
-    "ld   r22, Z\n"
-    "ldd  r23, Z+1\n"
-    "ldd  r24, Z+2\n"
-    "ldd  r25, Z+3\n"
-    "ldd  r18, Z+4\n"
-    "cp   r1, r18\n"
-    "brlt 3f\n" // e > 0
-    "neg  r18\n"
-    "cpi  r18, 32\n"
-    "brsh 5f\n"
-    "1:\n"
-    "cpi  r18, 8\n"
-    "brlo 2f\n"
-    "mov  r22, r23\n"
-    "mov  r23, r24\n"
-    "mov  r24, r25\n"
-    "clr  r25\n"
-    "subi r18, 8\n"
-    "rjmp 1b\n"
-    "2:\n"
-    "dec  r18\n"
-    "brmi 4f\n"
-    "lsr  r25\n"
-    "ror  r24\n"
-    "ror  r23\n"
-    "ror  r22\n"
-    "rjmp 2b\n"
-    "3:\n"
-    "tst  r25\n" // normalised: zero iff the top byte is
-    "breq 4f\n"
-    "rjmp .Lof_sat\n" // at least 2^32
-    "5:\n"
+    "ld   r18, Z\n"
+    "ldd  r19, Z+1\n"
+    "ldd  r20, Z+2\n"
+    "ldd  r21, Z+3\n"
+    "ldd  r30, Z+4\n" // e
     "clr  r22\n"
     "clr  r23\n"
     "movw r24, r22\n"
-    "4:\n"
+    "cp   r1, r30\n"
+    "brlt 1f\n"  // e > 0
+    "neg  r30\n" // -e, 0..128
+    "rjmp .Lshr_sat\n"
+    "1:\n"
+    "tst  r21\n" // normalised: zero iff the top byte is
+    "breq 2f\n"
+    "rjmp .Lof_sat\n" // at least 2^32
+    "2:\n"
     "ret\n"
     ".size _ZNK2ll3Num3u32Ev, .-_ZNK2ll3Num3u32Ev\n"
     ".text\n");
