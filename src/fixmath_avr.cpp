@@ -667,12 +667,9 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "or   r27, r21\n"
     "or   r27, r22\n"
     "or   r27, r23\n"
-    "breq .Lof_zero\n" // x == 0
-    "ldd  r27, Z+3\n"
-    "tst  r27\n"
-    "breq .Lof_zero\n" // m == 0 (normalised: by its top byte)
+    "breq .Lof_zero\n" // x == 0 (an axis that does not move)
     "cpi  r26, 1\n"
-    "brge .Lof_sat\n" // e > 0: x m 2^e >= 2^32
+    "brge .Lof_big\n" // e > 0
     "cpi  r26, 0xC1\n"
     "brlt .Lof_zero\n" // e <= -64
     "movw r24, r22\n"  // a = x
@@ -685,6 +682,11 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "push r13\n"
     "mov  r13, r26\n"
     "rjmp .Lmul_shr_go\n"
+    ".Lof_big:\n" // e > 0: zero for a zero m, else x m 2^e >= 2^32 (a zero m with e <= 0 gives
+                  // zero through mul_shr: no test on the common path)
+    "ldd  r27, Z+3\n"
+    "tst  r27\n"
+    "breq .Lof_zero\n" // normalised: zero iff the top byte is
     ".Lof_sat:\n"
     "ldi  r22, 0xFF\n"
     "ldi  r23, 0xFF\n"
