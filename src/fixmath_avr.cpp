@@ -515,10 +515,7 @@ asm(".section .text._ZN2ll3Num3addERKS0_,\"ax\",@progbits\n"
     "ld   r20, X+\n"
     "ld   r21, X+\n"
     "ld   r27, X\n" // o.e (X no longer needed)
-    "mov  r0, r18\n"
-    "or   r0, r19\n"
-    "or   r0, r20\n"
-    "or   r0, r21\n"
+    "tst  r21\n"    // normalised: zero iff the top byte is
     "brne 0f\n"
     "rjmp .Ladd_ret\n" // o == 0
     "0:\n"
@@ -527,10 +524,7 @@ asm(".section .text._ZN2ll3Num3addERKS0_,\"ax\",@progbits\n"
     "ldd  r24, Z+2\n"
     "ldd  r25, Z+3\n"
     "ldd  r26, Z+4\n" // e
-    "mov  r0, r22\n"
-    "or   r0, r23\n"
-    "or   r0, r24\n"
-    "or   r0, r25\n"
+    "tst  r25\n"
     "brne 1f\n"
     "movw r22, r18\n" // this == 0: the sum is o
     "movw r24, r20\n"
@@ -791,19 +785,15 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     ".size _ZNK2ll3Num3u32Ev, .-_ZNK2ll3Num3u32Ev\n"
     ".text\n");
 
-// Num& Num::shift(int8_t k): k in r22; e += k unless the value is zero.
+// Num& Num::shift(int8_t k): k in r22; e += k unless the value is zero (normalised: zero iff
+// the top byte is).
 asm(".section .text._ZN2ll3Num5shiftEa,\"ax\",@progbits\n"
     ".global _ZN2ll3Num5shiftEa\n"
     ".type _ZN2ll3Num5shiftEa, @function\n"
     "_ZN2ll3Num5shiftEa:\n"
     "movw r30, r24\n"
-    "ld   r18, Z\n"
-    "ldd  r19, Z+1\n"
-    "or   r18, r19\n"
-    "ldd  r19, Z+2\n"
-    "or   r18, r19\n"
-    "ldd  r19, Z+3\n"
-    "or   r18, r19\n"
+    "ldd  r18, Z+3\n"
+    "tst  r18\n"
     "breq 1f\n"
     "ldd  r18, Z+4\n"
     "add  r18, r22\n"
