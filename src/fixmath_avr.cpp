@@ -389,19 +389,6 @@ asm(".section .text._ZN2ll5num64Emma,\"ax\",@progbits\n"
     "subi r26, 0xE0\n"
     "sbci r27, 0xFF\n"
     "ldi  r30, 8\n"
-    "mov  r0, r22\n" // hi == 0 (sums of squares of short moves): lo moved up at once
-    "or   r0, r23\n"
-    "or   r0, r24\n"
-    "or   r0, r25\n"
-    "brne .Ln64_bytes\n"
-    "movw r22, r18\n"
-    "movw r24, r20\n"
-    "clr  r18\n"
-    "clr  r19\n"
-    "movw r20, r18\n"
-    "subi r26, 32\n"
-    "sbci r27, 0\n"
-    "ldi  r30, 4\n"
     ".Ln64_bytes:\n"
     "tst  r25\n"
     "brne .Ln64_bits\n"
@@ -610,17 +597,10 @@ asm(".section .text._ZNK2ll3Num3cmpERKS0_,\"ax\",@progbits\n"
     "ld   r23, X+\n"
     "ld   r30, X+\n"
     "ld   r31, X+\n"
-    "ld   r24, X\n"  // o.e
-    "mov  r0, r22\n" // zero operands: by the whole mantissa
-    "or   r0, r23\n"
-    "or   r0, r30\n"
-    "or   r0, r31\n"
-    "mov  r26, r18\n"
-    "or   r26, r19\n"
-    "or   r26, r20\n"
-    "or   r26, r21\n"
+    "ld   r24, X\n" // o.e
+    "tst  r21\n"    // zero operands (normalised: by the top byte)
     "breq .Lcmp_this0\n"
-    "tst  r0\n"
+    "tst  r31\n"
     "breq .Lcmp_gt\n" // o == 0 < this
     "cp   r25, r24\n"
     "brlt .Lcmp_lt\n"
@@ -635,7 +615,7 @@ asm(".section .text._ZNK2ll3Num3cmpERKS0_,\"ax\",@progbits\n"
     "clr  r24\n"
     "ret\n"
     ".Lcmp_this0:\n"
-    "tst  r0\n"
+    "tst  r31\n"
     "breq .Lcmp_eq\n" // both zero
     ".Lcmp_lt:\n"
     "ldi  r24, 0xFF\n"
@@ -673,8 +653,6 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "ldd  r20, Z+2\n"
     "ldd  r21, Z+3\n"
     "neg  r26\n"
-    "push r13\n"
-    "mov  r13, r26\n"
     "rjmp .Lmul_shr_go\n"
     ".Lof_big:\n" // e > 0: zero for a zero m, else x m 2^e >= 2^32 (a zero m with e <= 0 gives
                   // zero through mul_shr: no test on the common path)
@@ -695,20 +673,19 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     ".global _ZN2ll7mul_shrEmmh\n"
     ".type _ZN2ll7mul_shrEmmh, @function\n"
     "_ZN2ll7mul_shrEmmh:\n"
-    "push r13\n"
-    "mov  r13, r16\n"
-    ".Lmul_shr_go:\n"
-    "push r14\n" // __ll_mul32 uses r14..r17 (saved here: faster and two bytes less stack
-    "push r15\n" // than __ll_mul32s, on the step generator's path)
+    "mov  r26, r16\n"
+    ".Lmul_shr_go:\n" // the shift in r26, kept on the stack
+    "push r14\n"      // __ll_mul32 uses r14..r17 (saved here: faster and two bytes less stack
+    "push r15\n"      // than __ll_mul32s, on the step generator's path)
     "push r16\n"
     "push r17\n"
+    "push r26\n"
     "call __ll_mul32\n" // lo r18..r21, hi r22..r25
-    "mov  r30, r13\n"
+    "pop  r30\n"
     "pop  r17\n"
     "pop  r16\n"
     "pop  r15\n"
     "pop  r14\n"
-    "pop  r13\n"
     ".Lshr_sat:\n"   // r18..r25 >> r30 (any count), saturated to 32 bits, into r22..r25
     "cpi  r30, 16\n" // 16 bits at a time by word moves (9 cycles instead of 26)
     "brlo 1f\n"
@@ -825,10 +802,7 @@ asm(".section .text._ZN2ll3Num4sqrtEv,\"ax\",@progbits\n"
     "ldd  r13, Y+1\n"
     "ldd  r14, Y+2\n"
     "ldd  r15, Y+3\n"
-    "mov  r0, r12\n"
-    "or   r0, r13\n"
-    "or   r0, r14\n"
-    "or   r0, r15\n"
+    "tst  r15\n" // normalised: zero iff the top byte is
     "brne 0f\n"
     "rjmp .Lsqrt_ret\n" // zero stays zero
     "0:\n"
@@ -1166,38 +1140,90 @@ asm(".section .progmem.data.__ll_atan_q29,\"a\",@progbits\n"
     ".text\n");
 
 // Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask): v in r24:r25, n in r22, mask in
-// r20; the Num in r18..r22 as num64 returns it. fixmath.cpp's C in one routine: the top bytes of
-// all n values ORed (any >= 0x40: every value loses two bits, exp 4), then the squares of the
-// masked nonzero values summed exactly in r2..r9 (a zero, an axis that does not move, skips its
-// product: about 100 cycles) and num64. The registers are saved by libgcc's __prologue_saves__
-// (Y the frame pointer for the restore; r28 holds exp meanwhile, __ll_mul32 using r16).
+// r20; the Num in r18..r22 as num64 returns it. fixmath.cpp's C in one routine. The n values'
+// top bytes ORed (any >= 0x40: every value loses two bits, exp 4), and their bytes 1 (bit 7
+// only) and 2: for at most 4 values all below 2^15 (short moves), the squares take three
+// hardware products each and their sum (below 2^32) stays in call-clobbered registers, then
+// __ll_norm (about 400 cycles less: no register saved, no __ll_mul32, no num64). Else the
+// squares of the masked nonzero values summed exactly in r2..r9 (a zero, an axis that does not
+// move, skips its product: about 100 cycles) and num64, the registers saved by libgcc's
+// __prologue_saves__ (Y the frame pointer for the restore; r28 holds exp meanwhile, __ll_mul32
+// using r16).
 asm(".section .text._ZN2ll11sum_squaresEPKmhh,\"ax\",@progbits\n"
     ".global _ZN2ll11sum_squaresEPKmhh\n"
     ".type _ZN2ll11sum_squaresEPKmhh, @function\n"
     "_ZN2ll11sum_squaresEPKmhh:\n"
-    "ldi  r26, 0\n" // no frame
+    "movw r30, r24\n"
+    "mov  r26, r22\n"
+    "clr  r0\n"  // top bytes
+    "clr  r27\n" // bytes 2
+    "clr  r23\n" // bytes 1
+    "rjmp 2f\n"
+    "1:\n"
+    "ldd  r21, Z+3\n"
+    "or   r0, r21\n"
+    "ldd  r21, Z+2\n"
+    "or   r27, r21\n"
+    "ldd  r21, Z+1\n"
+    "or   r23, r21\n"
+    "adiw r30, 4\n"
+    "2:\n"
+    "subi r26, 1\n"
+    "brcc 1b\n"
+    "andi r23, 0x80\n"
+    "or   r27, r23\n"
+    "or   r27, r0\n"
+    "brne 3f\n"
+    "cpi  r22, 5\n"
+    "brlo .Lss_short\n"
+    "3:\n"
+    "mov  r21, r0\n" // kept by __prologue_saves__
+    "ldi  r26, 0\n"  // no frame
     "ldi  r27, 0\n"
     "ldi  r30, lo8(pm(.Lss_body))\n"
     "ldi  r31, hi8(pm(.Lss_body))\n"
     "jmp  __prologue_saves__\n" // r2..r17, r28, r29
+    ".Lss_short:\n"             // Z = v, mask in r26, n in r22, the sum in r18..r21; r27 = 0
+    "movw r30, r24\n"
+    "mov  r26, r20\n"
+    "clr  r18\n"
+    "clr  r19\n"
+    "movw r20, r18\n"
+    "rjmp 5f\n"
+    "4:\n"
+    "ld   r24, Z+\n"
+    "ld   r25, Z+\n"
+    "adiw r30, 2\n"
+    "lsr  r26\n"
+    "brcc 5f\n" // not in the mask
+    "mul  r24, r24\n"
+    "add  r18, r0\n"
+    "adc  r19, r1\n"
+    "adc  r20, r27\n"
+    "adc  r21, r27\n"
+    "mul  r25, r25\n"
+    "add  r20, r0\n"
+    "adc  r21, r1\n"
+    "mul  r24, r25\n" // twice
+    "add  r19, r0\n"
+    "adc  r20, r1\n"
+    "adc  r21, r27\n"
+    "add  r19, r0\n"
+    "adc  r20, r1\n"
+    "adc  r21, r27\n"
+    "5:\n"
+    "subi r22, 1\n"
+    "brcc 4b\n"
+    "clr  r1\n"
+    "call __ll_norm\n"
+    "mov  r22, r26\n"
+    "ret\n"
     ".Lss_body:\n"
     "movw r12, r24\n" // v
     "mov  r10, r22\n" // n
     "mov  r11, r20\n" // mask
     "clr  r28\n"      // exp: 0, or 4 when two bits are dropped (r28: __ll_mul32 uses r16)
-    "tst  r10\n"
-    "breq 3f\n"
-    "movw r30, r24\n"
-    "mov  r26, r22\n"
-    "clr  r0\n"
-    "1:\n"
-    "ldd  r27, Z+3\n"
-    "or   r0, r27\n"
-    "adiw r30, 4\n"
-    "dec  r26\n"
-    "brne 1b\n"
-    "mov  r27, r0\n"
-    "andi r27, 0xC0\n"
+    "andi r21, 0xC0\n"
     "breq 3f\n"
     "ldi  r28, 4\n"
     "3:\n"
