@@ -627,7 +627,8 @@ asm(".section .text._ZNK2ll3Num3cmpERKS0_,\"ax\",@progbits\n"
 
 // uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift): a in r22..r25, b in r18..r21, shift
 // in r16 (call-saved: read only). The 64-bit product (__ll_mul32), shifted by whole bytes,
-// then bit by bit on the five bytes that matter; saturated when anything is left above them.
+// then the last bits by hardware products on the five bytes that matter; saturated when
+// anything is left above them.
 asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     // uint32_t Num::of(uint32_t x) const: this in r24:r25, x in r20..r23. floor(x m 2^e):
     // 0 below 2^-64 or for a zero operand, saturated for e > 0, else mul_shr(x, m, -e).
