@@ -68,6 +68,7 @@ asm(".section .text.__ll_set,\"ax\",@progbits\n"
     "breq .Lset_zero\n"
     "add  r27, r26\n"
     "brvs .Lset_zero\n"
+    "1:\n"
     "st   Z, r18\n"
     "std  Z+1, r19\n"
     "std  Z+2, r20\n"
@@ -75,12 +76,11 @@ asm(".section .text.__ll_set,\"ax\",@progbits\n"
     "std  Z+4, r27\n"
     "ret\n"
     ".Lset_zero:\n"
-    "st   Z, r1\n"
-    "std  Z+1, r1\n"
-    "std  Z+2, r1\n"
-    "std  Z+3, r1\n"
-    "std  Z+4, r1\n"
-    "ret\n"
+    "clr  r18\n"
+    "clr  r19\n"
+    "movw r20, r18\n"
+    "clr  r27\n"
+    "rjmp 1b\n"
     ".size __ll_set, .-__ll_set\n");
 
 // Num& Num::mul(const Num& o): &o in r22:r23. The 64-bit product of the mantissas by
@@ -173,6 +173,7 @@ asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n"
     "sbc  r0, r0\n"
     "cp   r0, r13\n"
     "brne 1f\n"
+    "2:\n"
     "st   Y, r22\n"
     "std  Y+1, r23\n"
     "std  Y+2, r24\n"
@@ -182,14 +183,12 @@ asm(".section .text._ZN2ll3Num3mulERKS0_,\"ax\",@progbits\n"
     "1:\n"
     "sbrc r13, 7\n"
     "rjmp .Lmul_zero\n" // below -128
-    "ldi  r18, 0xFF\n"
-    "st   Y, r18\n"
-    "std  Y+1, r18\n"
-    "std  Y+2, r18\n"
-    "std  Y+3, r18\n"
-    "ldi  r18, 0x7F\n"
-    "std  Y+4, r18\n"
-    "rjmp .Lmul_ret\n"
+    "ldi  r22, 0xFF\n"  // saturated
+    "ldi  r23, 0xFF\n"
+    "movw r24, r22\n"
+    "ldi  r26, 0x7F\n"
+    "mov  r12, r26\n"
+    "rjmp 2b\n"
     ".Lmul_zero:\n"
     "st   Y, r1\n"
     "std  Y+1, r1\n"
@@ -389,19 +388,6 @@ asm(".section .text._ZN2ll5num64Emma,\"ax\",@progbits\n"
     "subi r26, 0xE0\n"
     "sbci r27, 0xFF\n"
     "ldi  r30, 8\n"
-    "mov  r0, r22\n" // hi == 0 (sums of squares of short moves): lo moved up at once
-    "or   r0, r23\n"
-    "or   r0, r24\n"
-    "or   r0, r25\n"
-    "brne .Ln64_bytes\n"
-    "movw r22, r18\n"
-    "movw r24, r20\n"
-    "clr  r18\n"
-    "clr  r19\n"
-    "movw r20, r18\n"
-    "subi r26, 32\n"
-    "sbci r27, 0\n"
-    "ldi  r30, 4\n"
     ".Ln64_bytes:\n"
     "tst  r25\n"
     "brne .Ln64_bits\n"
@@ -461,7 +447,9 @@ asm(".section .text._ZN2ll5num64Emma,\"ax\",@progbits\n"
 
 // uint32_t div32_16(uint32_t n, uint16_t d): n in r22..r25, d in r20:r21; the quotient in
 // r22..r25. Restoring division: n shifts into a 16-bit remainder (its 17th bit in the carry)
-// and the quotient bits into the room n leaves.
+// and the quotient bits into the room n leaves. When n's top byte is below d (quotients below
+// 2^24, as the step generator's), the first 8 turns only move it into the remainder: done by
+// byte moves (104 cycles less).
 asm(".section .text._ZN2ll8div32_16Emj,\"ax\",@progbits\n"
     ".global _ZN2ll8div32_16Emj\n"
     ".type _ZN2ll8div32_16Emj, @function\n"
@@ -469,6 +457,15 @@ asm(".section .text._ZN2ll8div32_16Emj,\"ax\",@progbits\n"
     "clr  r26\n"
     "clr  r27\n"
     "ldi  r30, 32\n"
+    "cp   r25, r20\n"
+    "cpc  r1, r21\n"
+    "brsh 1f\n"
+    "mov  r26, r25\n"
+    "mov  r25, r24\n"
+    "mov  r24, r23\n"
+    "mov  r23, r22\n"
+    "clr  r22\n"
+    "ldi  r30, 24\n"
     "1:\n"
     "lsl  r22\n"
     "rol  r23\n"
@@ -504,10 +501,7 @@ asm(".section .text._ZN2ll3Num3addERKS0_,\"ax\",@progbits\n"
     "ld   r20, X+\n"
     "ld   r21, X+\n"
     "ld   r27, X\n" // o.e (X no longer needed)
-    "mov  r0, r18\n"
-    "or   r0, r19\n"
-    "or   r0, r20\n"
-    "or   r0, r21\n"
+    "tst  r21\n"    // normalised: zero iff the top byte is
     "brne 0f\n"
     "rjmp .Ladd_ret\n" // o == 0
     "0:\n"
@@ -516,10 +510,7 @@ asm(".section .text._ZN2ll3Num3addERKS0_,\"ax\",@progbits\n"
     "ldd  r24, Z+2\n"
     "ldd  r25, Z+3\n"
     "ldd  r26, Z+4\n" // e
-    "mov  r0, r22\n"
-    "or   r0, r23\n"
-    "or   r0, r24\n"
-    "or   r0, r25\n"
+    "tst  r25\n"
     "brne 1f\n"
     "movw r22, r18\n" // this == 0: the sum is o
     "movw r24, r20\n"
@@ -605,17 +596,10 @@ asm(".section .text._ZNK2ll3Num3cmpERKS0_,\"ax\",@progbits\n"
     "ld   r23, X+\n"
     "ld   r30, X+\n"
     "ld   r31, X+\n"
-    "ld   r24, X\n"  // o.e
-    "mov  r0, r22\n" // zero operands: by the whole mantissa
-    "or   r0, r23\n"
-    "or   r0, r30\n"
-    "or   r0, r31\n"
-    "mov  r26, r18\n"
-    "or   r26, r19\n"
-    "or   r26, r20\n"
-    "or   r26, r21\n"
+    "ld   r24, X\n" // o.e
+    "tst  r21\n"    // zero operands (normalised: by the top byte)
     "breq .Lcmp_this0\n"
-    "tst  r0\n"
+    "tst  r31\n"
     "breq .Lcmp_gt\n" // o == 0 < this
     "cp   r25, r24\n"
     "brlt .Lcmp_lt\n"
@@ -630,7 +614,7 @@ asm(".section .text._ZNK2ll3Num3cmpERKS0_,\"ax\",@progbits\n"
     "clr  r24\n"
     "ret\n"
     ".Lcmp_this0:\n"
-    "tst  r0\n"
+    "tst  r31\n"
     "breq .Lcmp_eq\n" // both zero
     ".Lcmp_lt:\n"
     "ldi  r24, 0xFF\n"
@@ -643,7 +627,8 @@ asm(".section .text._ZNK2ll3Num3cmpERKS0_,\"ax\",@progbits\n"
 
 // uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift): a in r22..r25, b in r18..r21, shift
 // in r16 (call-saved: read only). The 64-bit product (__ll_mul32), shifted by whole bytes,
-// then bit by bit on the five bytes that matter; saturated when anything is left above them.
+// then the last bits by hardware products on the five bytes that matter; saturated when
+// anything is left above them.
 asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     // uint32_t Num::of(uint32_t x) const: this in r24:r25, x in r20..r23. floor(x m 2^e):
     // 0 below 2^-64 or for a zero operand, saturated for e > 0, else mul_shr(x, m, -e).
@@ -656,12 +641,9 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "or   r27, r21\n"
     "or   r27, r22\n"
     "or   r27, r23\n"
-    "breq .Lof_zero\n" // x == 0
-    "ldd  r27, Z+3\n"
-    "tst  r27\n"
-    "breq .Lof_zero\n" // m == 0 (normalised: by its top byte)
+    "breq .Lof_zero\n" // x == 0 (an axis that does not move)
     "cpi  r26, 1\n"
-    "brge .Lof_sat\n" // e > 0: x m 2^e >= 2^32
+    "brge .Lof_big\n" // e > 0
     "cpi  r26, 0xC1\n"
     "brlt .Lof_zero\n" // e <= -64
     "movw r24, r22\n"  // a = x
@@ -671,9 +653,12 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "ldd  r20, Z+2\n"
     "ldd  r21, Z+3\n"
     "neg  r26\n"
-    "push r13\n"
-    "mov  r13, r26\n"
     "rjmp .Lmul_shr_go\n"
+    ".Lof_big:\n" // e > 0: zero for a zero m, else x m 2^e >= 2^32 (a zero m with e <= 0 gives
+                  // zero through mul_shr: no test on the common path)
+    "ldd  r27, Z+3\n"
+    "tst  r27\n"
+    "breq .Lof_zero\n" // normalised: zero iff the top byte is
     ".Lof_sat:\n"
     "ldi  r22, 0xFF\n"
     "ldi  r23, 0xFF\n"
@@ -685,23 +670,45 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "movw r24, r22\n"
     "ret\n"
     ".size _ZNK2ll3Num2ofEm, .-_ZNK2ll3Num2ofEm\n"
+    // uint32_t Num::u32() const: floor(m 2^e), saturated: m >> -e by .Lshr_sat (e <= -32 gives
+    // zero there; saturation from Num::of).
+    ".global _ZNK2ll3Num3u32Ev\n"
+    ".type _ZNK2ll3Num3u32Ev, @function\n"
+    "_ZNK2ll3Num3u32Ev:\n"
+    "movw r30, r24\n"
+    "ld   r18, Z\n"
+    "ldd  r19, Z+1\n"
+    "ldd  r20, Z+2\n"
+    "ldd  r21, Z+3\n"
+    "ldd  r30, Z+4\n" // e
+    "clr  r22\n"
+    "clr  r23\n"
+    "movw r24, r22\n"
+    "cp   r1, r30\n"
+    "brlt 1f\n"  // e > 0
+    "neg  r30\n" // -e, 0..128
+    "rjmp .Lshr_sat\n"
+    "1:\n"
+    "tst  r21\n"      // normalised: zero iff the top byte is
+    "brne .Lof_sat\n" // at least 2^32
+    "ret\n"
+    ".size _ZNK2ll3Num3u32Ev, .-_ZNK2ll3Num3u32Ev\n"
     ".global _ZN2ll7mul_shrEmmh\n"
     ".type _ZN2ll7mul_shrEmmh, @function\n"
     "_ZN2ll7mul_shrEmmh:\n"
-    "push r13\n"
-    "mov  r13, r16\n"
-    ".Lmul_shr_go:\n"
-    "push r14\n" // __ll_mul32 uses r14..r17 (saved here: faster and two bytes less stack
-    "push r15\n" // than __ll_mul32s, on the step generator's path)
+    "mov  r26, r16\n"
+    ".Lmul_shr_go:\n" // the shift in r26, kept on the stack
+    "push r14\n"      // __ll_mul32 uses r14..r17 (saved here: faster and two bytes less stack
+    "push r15\n"      // than __ll_mul32s, on the step generator's path)
     "push r16\n"
     "push r17\n"
+    "push r26\n"
     "call __ll_mul32\n" // lo r18..r21, hi r22..r25
-    "mov  r30, r13\n"
+    "pop  r30\n"
     "pop  r17\n"
     "pop  r16\n"
     "pop  r15\n"
     "pop  r14\n"
-    "pop  r13\n"
     ".Lshr_sat:\n"   // r18..r25 >> r30 (any count), saturated to 32 bits, into r22..r25
     "cpi  r30, 16\n" // 16 bits at a time by word moves (9 cycles instead of 26)
     "brlo 1f\n"
@@ -728,16 +735,32 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "2:\n"
     "tst  r30\n"
     "breq 4f\n"
-    "or   r23, r24\n" // the bytes above the fifth only count as nonzero
-    "or   r23, r25\n"
-    "3:\n"
-    "lsr  r22\n"
-    "ror  r21\n"
-    "ror  r20\n"
-    "ror  r19\n"
-    "ror  r18\n"
+    // The last 1..7 bits by hardware products: byte k times 2^(8 - r30) is its share of
+    // result bytes k - 1 and k (30 cycles, against 3 + 8 a bit). The factor 0x80 >> (r30 - 1)
+    // from the bits of r30 - 1 (a swap for 4); the bytes above the fifth only count as nonzero.
     "dec  r30\n"
-    "brne 3b\n"
+    "ldi  r26, 0x80\n"
+    "sbrc r30, 1\n"
+    "ldi  r26, 0x20\n"
+    "sbrc r30, 0\n"
+    "lsr  r26\n"
+    "sbrc r30, 2\n"
+    "swap r26\n"
+    "mul  r18, r26\n"
+    "mov  r18, r1\n"
+    "mul  r19, r26\n"
+    "or   r18, r0\n"
+    "mov  r19, r1\n"
+    "mul  r20, r26\n"
+    "or   r19, r0\n"
+    "mov  r20, r1\n"
+    "mul  r21, r26\n"
+    "or   r20, r0\n"
+    "mov  r21, r1\n"
+    "mul  r22, r26\n"
+    "or   r21, r0\n"
+    "mov  r22, r1\n"
+    "clr  r1\n"
     "4:\n"
     "or   r22, r23\n"
     "or   r22, r24\n"
@@ -751,65 +774,18 @@ asm(".section .text._ZN2ll7mul_shrEmmh,\"ax\",@progbits\n"
     "movw r24, r20\n"
     "ret\n"
     ".size _ZN2ll7mul_shrEmmh, .-_ZN2ll7mul_shrEmmh\n"
-    // uint32_t Num::u32() const: floor(m 2^e), saturated; whole bytes first, then bits (zero and
-    // saturation from Num::of).
-    ".global _ZNK2ll3Num3u32Ev\n"
-    ".type _ZNK2ll3Num3u32Ev, @function\n"
-    "_ZNK2ll3Num3u32Ev:\n"
-    "movw r30, r24\n"
-    "ld   r22, Z\n"
-    "ldd  r23, Z+1\n"
-    "ldd  r24, Z+2\n"
-    "ldd  r25, Z+3\n"
-    "ldd  r18, Z+4\n"
-    "cp   r1, r18\n"
-    "brlt 3f\n" // e > 0
-    "neg  r18\n"
-    "cpi  r18, 32\n"
-    "brsh 5f\n"
-    "1:\n"
-    "cpi  r18, 8\n"
-    "brlo 2f\n"
-    "mov  r22, r23\n"
-    "mov  r23, r24\n"
-    "mov  r24, r25\n"
-    "clr  r25\n"
-    "subi r18, 8\n"
-    "rjmp 1b\n"
-    "2:\n"
-    "dec  r18\n"
-    "brmi 4f\n"
-    "lsr  r25\n"
-    "ror  r24\n"
-    "ror  r23\n"
-    "ror  r22\n"
-    "rjmp 2b\n"
-    "3:\n"
-    "tst  r25\n" // normalised: zero iff the top byte is
-    "breq 4f\n"
-    "rjmp .Lof_sat\n" // at least 2^32
-    "5:\n"
-    "clr  r22\n"
-    "clr  r23\n"
-    "movw r24, r22\n"
-    "4:\n"
-    "ret\n"
-    ".size _ZNK2ll3Num3u32Ev, .-_ZNK2ll3Num3u32Ev\n"
+
     ".text\n");
 
-// Num& Num::shift(int8_t k): k in r22; e += k unless the value is zero.
+// Num& Num::shift(int8_t k): k in r22; e += k unless the value is zero (normalised: zero iff
+// the top byte is).
 asm(".section .text._ZN2ll3Num5shiftEa,\"ax\",@progbits\n"
     ".global _ZN2ll3Num5shiftEa\n"
     ".type _ZN2ll3Num5shiftEa, @function\n"
     "_ZN2ll3Num5shiftEa:\n"
     "movw r30, r24\n"
-    "ld   r18, Z\n"
-    "ldd  r19, Z+1\n"
-    "or   r18, r19\n"
-    "ldd  r19, Z+2\n"
-    "or   r18, r19\n"
-    "ldd  r19, Z+3\n"
-    "or   r18, r19\n"
+    "ldd  r18, Z+3\n"
+    "tst  r18\n"
     "breq 1f\n"
     "ldd  r18, Z+4\n"
     "add  r18, r22\n"
@@ -841,10 +817,7 @@ asm(".section .text._ZN2ll3Num4sqrtEv,\"ax\",@progbits\n"
     "ldd  r13, Y+1\n"
     "ldd  r14, Y+2\n"
     "ldd  r15, Y+3\n"
-    "mov  r0, r12\n"
-    "or   r0, r13\n"
-    "or   r0, r14\n"
-    "or   r0, r15\n"
+    "tst  r15\n" // normalised: zero iff the top byte is
     "brne 0f\n"
     "rjmp .Lsqrt_ret\n" // zero stays zero
     "0:\n"
@@ -901,21 +874,14 @@ asm(".section .text._ZN2ll3Num4sqrtEv,\"ax\",@progbits\n"
     "cp   r12, r24\n"
     "cpc  r13, r25\n"
     "brcs 6f\n"
-    "sub  r12, r24\n" // no borrow: C clear, a quotient bit 1
+    "5:\n"
+    "sub  r12, r24\n" // a quotient bit 1 (C clear; from the 17th bit, the subtraction borrows)
     "sbc  r13, r25\n"
+    "clc\n"
     "6:\n"
     "rol  r18\n"
     "rol  r19\n"
     "brcc 4b\n"
-    "rjmp 7f\n"
-    "5:\n"
-    "sub  r12, r24\n"
-    "sbc  r13, r25\n"
-    "clc\n"
-    "rol  r18\n"
-    "rol  r19\n"
-    "brcc 4b\n"
-    "7:\n"
     "com  r18\n"
     "com  r19\n"
     "lsr  r20\n" // q = q0 2^15 + the 15 bits: q >> 16 in r20
@@ -1182,38 +1148,88 @@ asm(".section .progmem.data.__ll_atan_q29,\"a\",@progbits\n"
     ".text\n");
 
 // Num sum_squares(const uint32_t v[], uint8_t n, uint8_t mask): v in r24:r25, n in r22, mask in
-// r20; the Num in r18..r22 as num64 returns it. fixmath.cpp's C in one routine: the top bytes of
-// all n values ORed (any >= 0x40: every value loses two bits, exp 4), then the squares of the
-// masked nonzero values summed exactly in r2..r9 (a zero, an axis that does not move, skips its
-// product: about 100 cycles) and num64. The registers are saved by libgcc's __prologue_saves__
-// (Y the frame pointer for the restore; r28 holds exp meanwhile, __ll_mul32 using r16).
+// r20; the Num in r18..r22 as num64 returns it. fixmath.cpp's C in one routine. The n values'
+// top bytes ORed (any >= 0x40: every value loses two bits, exp 4), and their bytes 1 (bit 7
+// only) and 2: for at most 4 values all below 2^15 (short moves), the squares take three
+// hardware products each and their sum (below 2^32) stays in call-clobbered registers, then
+// __ll_norm (about 400 cycles less: no register saved, no __ll_mul32, no num64). Else the
+// squares of the masked nonzero values summed exactly in r2..r9 (a zero, an axis that does not
+// move, skips its product: about 100 cycles) and num64, the registers saved by libgcc's
+// __prologue_saves__ (Y the frame pointer for the restore; r28 holds exp meanwhile, __ll_mul32
+// using r16).
 asm(".section .text._ZN2ll11sum_squaresEPKmhh,\"ax\",@progbits\n"
     ".global _ZN2ll11sum_squaresEPKmhh\n"
     ".type _ZN2ll11sum_squaresEPKmhh, @function\n"
     "_ZN2ll11sum_squaresEPKmhh:\n"
-    "ldi  r26, 0\n" // no frame
+    "movw r30, r24\n"
+    "mov  r26, r22\n"
+    "clr  r0\n"  // top bytes
+    "clr  r27\n" // bytes 2, and bit 0 for a bit 7 of byte 1
+    "rjmp 2f\n"
+    "1:\n"
+    "ldd  r21, Z+3\n"
+    "or   r0, r21\n"
+    "ldd  r21, Z+2\n"
+    "or   r27, r21\n"
+    "ldd  r21, Z+1\n"
+    "sbrc r21, 7\n"
+    "ori  r27, 1\n"
+    "adiw r30, 4\n"
+    "2:\n"
+    "subi r26, 1\n"
+    "brcc 1b\n"
+    "or   r27, r0\n"
+    "brne 3f\n"
+    "cpi  r22, 5\n"
+    "brlo .Lss_short\n"
+    "3:\n"
+    "mov  r21, r0\n" // kept by __prologue_saves__
+    "ldi  r26, 0\n"  // no frame
     "ldi  r27, 0\n"
     "ldi  r30, lo8(pm(.Lss_body))\n"
     "ldi  r31, hi8(pm(.Lss_body))\n"
     "jmp  __prologue_saves__\n" // r2..r17, r28, r29
+    ".Lss_short:\n"             // Z = v, mask in r26, n in r22, the sum in r18..r21; r27 = 0
+    "movw r30, r24\n"
+    "mov  r26, r20\n"
+    "clr  r18\n"
+    "clr  r19\n"
+    "movw r20, r18\n"
+    "rjmp 5f\n"
+    "4:\n"
+    "ld   r24, Z+\n"
+    "ld   r25, Z+\n"
+    "adiw r30, 2\n"
+    "lsr  r26\n"
+    "brcc 5f\n" // not in the mask
+    "mul  r24, r24\n"
+    "add  r18, r0\n"
+    "adc  r19, r1\n"
+    "adc  r20, r27\n"
+    "adc  r21, r27\n"
+    "mul  r25, r25\n"
+    "add  r20, r0\n"
+    "adc  r21, r1\n"
+    "mul  r24, r25\n" // twice
+    "add  r19, r0\n"
+    "adc  r20, r1\n"
+    "adc  r21, r27\n"
+    "add  r19, r0\n"
+    "adc  r20, r1\n"
+    "adc  r21, r27\n"
+    "5:\n"
+    "subi r22, 1\n"
+    "brcc 4b\n"
+    "clr  r1\n"
+    "call __ll_norm\n"
+    "mov  r22, r26\n"
+    "ret\n"
     ".Lss_body:\n"
     "movw r12, r24\n" // v
     "mov  r10, r22\n" // n
     "mov  r11, r20\n" // mask
     "clr  r28\n"      // exp: 0, or 4 when two bits are dropped (r28: __ll_mul32 uses r16)
-    "tst  r10\n"
-    "breq 3f\n"
-    "movw r30, r24\n"
-    "mov  r26, r22\n"
-    "clr  r0\n"
-    "1:\n"
-    "ldd  r27, Z+3\n"
-    "or   r0, r27\n"
-    "adiw r30, 4\n"
-    "dec  r26\n"
-    "brne 1b\n"
-    "mov  r27, r0\n"
-    "andi r27, 0xC0\n"
+    "andi r21, 0xC0\n"
     "breq 3f\n"
     "ldi  r28, 4\n"
     "3:\n"

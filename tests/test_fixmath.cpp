@@ -115,3 +115,36 @@ TEST(FixMath, SmallAngleSeriesGiveCosSinAndTheArcControlArm) {
         EXPECT_NEAR(k / std::ldexp(1.0, 30), 4.0 / 3 * std::tan(h / 4), 4e-9) << h;
     }
 }
+
+// sum_squares is the truncated exact sum on both sides of the chip's short path (at most 4
+// values, all below 2^15: squares summed in 32 bits) and of its general one (num64 of a 64-bit
+// sum): the bounds where the chip changes path.
+TEST(FixMath, SumSquaresIsTheTruncatedExactSumAcrossTheShortPathBounds) {
+    auto exact = [](const uint32_t* v, uint8_t n, uint8_t mask) {
+        unsigned __int128 s = 0;
+        bool drop = false;
+        for (uint8_t i = 0; i < n; ++i) drop = drop || v[i] >= 0x40000000u;
+        for (uint8_t i = 0; i < n && i < 8; ++i) {
+            if (!(mask >> i & 1)) continue;
+            unsigned __int128 x = drop ? v[i] >> 2 : v[i];
+            s += x * x;
+        }
+        return std::ldexp(static_cast<long double>(s), drop ? 4 : 0);
+    };
+    const uint32_t edges[] = {0, 1, 0x7FFF, 0x8000, 0xFFFF, 0x10000, 0x3FFFFFFF, 0x40000000};
+    std::mt19937 rng(5);
+    for (int i = 0; i < 20000; ++i) {
+        uint32_t v[6];
+        for (uint32_t& x : v) x = edges[rng() % 8];
+        uint8_t n = static_cast<uint8_t>(rng() % 7), mask = static_cast<uint8_t>(rng());
+        ll::Num got = ll::sum_squares(v, n, mask);
+        long double want = exact(v, n, mask);
+        // Truncated to 32 significant bits: within one unit of the last place, never above.
+        EXPECT_LE(value(got), want);
+        EXPECT_GT(value(got), want * (1 - std::ldexp(1.0L, -31)) - 1e-30L);
+    }
+    const uint32_t four[4] = {0x7FFF, 0x7FFF, 0x7FFF, 0x7FFF}; // the short path's largest sum
+    EXPECT_EQ(value(ll::sum_squares(four, 4)), 4.0L * 0x7FFF * 0x7FFF);
+    const uint32_t over[2] = {0x8000, 0x7FFF}; // one value at 2^15: the general path
+    EXPECT_EQ(value(ll::sum_squares(over, 2)), 1073741824.0L + 0x7FFFL * 0x7FFF);
+}
