@@ -151,6 +151,17 @@ inline uint32_t fixmath_edges() {
             h.add(ll::Num(y).div(x));
         }
     }
+    // sum_squares at the bounds of the chip's short path (at most 4 values, each below 2^15):
+    // every value 0x7FFF, one of them 0x8000, five values, and masks with bits beyond n.
+    const uint32_t vs[5] = {0x7FFF, 0x7FFF, 0x7FFF, 0x7FFF, 0x7FFF};
+    for (uint8_t n = 1; n <= 5; ++n) {
+        for (uint8_t mask = 0; mask < 64; ++mask) h.add(ll::sum_squares(vs, n, mask));
+    }
+    for (uint8_t i = 0; i < 5; ++i) {
+        uint32_t w[5] = {0x7FFF, 0x7FFE, 1, 0, 0x7FFF};
+        w[i] = 0x8000;
+        for (uint8_t n = 3; n <= 5; ++n) h.add(ll::sum_squares(w, n));
+    }
     return h.h;
 }
 
