@@ -115,6 +115,54 @@ inline uint32_t fixmath_hash(uint16_t rounds) {
     return h.h;
 }
 
+// num::parse and the unit conversions on numbers as G-code writes them, hashed: a sign or
+// none, 0 to 11 integer digits (leading zeros too), a point or none, 0 to 8 decimals, then a
+// letter, a space or the end. Where the chip parses in assembly (numparse.cpp), this holds it to
+// the portable C that the host tests check.
+inline uint32_t parse_hash(uint16_t rounds) {
+    Hash h;
+    uint32_t s = 0x9E3779B9ul;
+    char buf[24];
+    for (uint16_t i = 0; i < rounds; ++i) {
+        uint8_t n = 0;
+        uint32_t r = xorshift(s);
+        if (r & 1) buf[n++] = (r & 2) ? '-' : '+';
+        const uint8_t idigits = static_cast<uint8_t>((r >> 2) % 12);
+        const uint8_t fdigits = static_cast<uint8_t>((r >> 6) % 9);
+        const uint8_t zeros = static_cast<uint8_t>((r >> 10) & 3); // leading zeros
+        for (uint8_t k = 0; k < idigits; ++k) {
+            const uint32_t d = xorshift(s) % 10;
+            buf[n++] = static_cast<char>('0' + (k < zeros ? 0 : d));
+        }
+        if (r & 0x1000) buf[n++] = '.';
+        for (uint8_t k = 0; k < fdigits; ++k) {
+            const uint32_t d = xorshift(s);
+            buf[n++] = static_cast<char>('0' + ((d & 0x30) == 0   ? 9
+                                                : (d & 0xC0) == 0 ? 0
+                                                                  : d % 10));
+        }
+        const uint8_t end = static_cast<uint8_t>((r >> 13) & 3);
+        if (end) buf[n++] = end == 1 ? 'X' : end == 2 ? ' ' : '.';
+        buf[n] = 0;
+        num::Decimal d{};
+        uint8_t pos = 0;
+        const bool ok = num::parse(buf, pos, d);
+        h.add(static_cast<uint32_t>(ok) | static_cast<uint32_t>(pos) << 8 |
+              static_cast<uint32_t>(d.flags) << 16 | static_cast<uint32_t>(d.sub) << 24);
+        if (!ok) continue;
+        h.add(d.ipart);
+        h.add(d.frac);
+        int32_t mm = 0, in = 0;
+        uint32_t u = 0;
+        const bool mm_ok = num::to_milli(d, mm), in_ok = num::inch_to_milli(d, in);
+        const bool u_ok = num::to_uint(d, 0xFFFFFFFFul >> (r >> 27), u);
+        h.add(static_cast<uint32_t>(mm) ^ (mm_ok ? 0x80000000ul : 0));
+        h.add(static_cast<uint32_t>(in) ^ (in_ok ? 0x80000000ul : 0));
+        h.add(u ^ (u_ok ? 0x80000000ul : 0));
+    }
+    return h.h;
+}
+
 // The edges that the random workload of fixmath_check.h rarely reaches, hashed: every root
 // s >= 2^15 at s^2 and at (s + 1)^2 - 1 (where isqrt32's Newton step on the chip overshoots
 // most) through isqrt32 and Num::sqrt, and Num::div by divisors at both ends of every top byte

@@ -26,5 +26,10 @@ TEST(FixMathAvr, AssemblyGivesThePortableResults) {
     for (int i = 3; i >= 0; --i)
         got_edges = got_edges << 8 | sim.peek(static_cast<uint16_t>(edges + i));
     EXPECT_EQ(got_edges, ll::check::fixmath_edges());
+    const uint16_t parse = static_cast<uint16_t>(sim.symbol("g_parse_hash") & 0xFFFF);
+    uint32_t got_parse = 0;
+    for (int i = 3; i >= 0; --i)
+        got_parse = got_parse << 8 | sim.peek(static_cast<uint16_t>(parse + i));
+    EXPECT_EQ(got_parse, ll::check::parse_hash(LL_FIXMATH_CHECK_ROUNDS));
     std::printf("%d rounds in %.1f M cycles\n", LL_FIXMATH_CHECK_ROUNDS, sim.cycle() / 1e6);
 }
