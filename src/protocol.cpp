@@ -324,32 +324,40 @@ void read_line() {
         if (!hal::serial_get(p.last)) return; // straight into p.last: no frame for it
         if (p.lost_after != 0 && --p.lost_after == 0) p.flags |= kLost;
         uint8_t c = p.last;
+        uint8_t f = p.flags;
+        // The common case first: outside comments, '-' to 'Z' but '/' and ';' (digits, '.',
+        // capitals) is kept as it is, without the tests below (about 20 cycles a byte).
+        if (!(f & (kInParen | kInSemicolon)) && static_cast<uint8_t>(c - '-') <= 'Z' - '-' &&
+            c != '/' && c != ';') {
+            goto keep;
+        }
         if (c == '\n' || c == '\r') {
             if (c == '\n' && prev == '\r') continue; // CR LF is one line end
             dispatch();
             return; // one line per run_once()
         }
-        uint8_t f = p.flags;
-        if (c == '\t') c = ' ';
-        if (c < 0x20 || c >= 0x7F) {
+        if (c == ' ' || c == '\t' || c == '/') {
+            // spaces and tabs, and block delete (ignored, as GRBL does), in comments too
+        } else if (c < 0x20 || c >= 0x7F) {
             f |= kBadByte; // GRBL drops such bytes and runs the rest; we refuse the line
         } else if (f & kInSemicolon) {
         } else if (f & kInParen) {
             if (c == ')') f &= static_cast<uint8_t>(~kInParen);
-        } else if (c == ' ' || c == '/') {
-            // spaces and tabs, and block delete (ignored, as GRBL does)
         } else if (c == '(') {
             f |= kInParen;
         } else if (c == ';') {
             f |= kInSemicolon;
-        } else if (p.len >= protocol::kLineMax) {
-            f |= kTooLong;
         } else {
             if (c >= 'a' && c <= 'z') c = static_cast<uint8_t>(c - ('a' - 'A'));
-            // Kept terminated: the pointer is at hand here (dispatch() would compute it).
-            char* at = p.line + p.len++;
-            at[0] = static_cast<char>(c);
-            at[1] = 0;
+        keep:
+            if (p.len >= protocol::kLineMax) {
+                f |= kTooLong;
+            } else {
+                // Kept terminated: the pointer is at hand here (dispatch() would compute it).
+                char* at = p.line + p.len++;
+                at[0] = static_cast<char>(c);
+                at[1] = 0;
+            }
         }
         p.flags = f;
     }
