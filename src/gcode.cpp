@@ -694,9 +694,10 @@ uint8_t execute(const char* line, uint8_t flags, Outcome& outcome) {
     // ---- Stage 2: import every word (letter + number), checking repeats, modal groups and
     // negative F N P S T.
     while (*line != 0) {
-        char letter = *line++;
-        if (letter < 'A' || letter > 'Z') return kExpectedCommandLetter;
-        uint8_t word = flash_read_byte(&kLetterInfo[letter - 'A']);
+        // (Unsigned: no sign extension of the index.)
+        uint8_t letter = static_cast<uint8_t>(static_cast<uint8_t>(*line++) - 'A');
+        if (letter > 'Z' - 'A') return kExpectedCommandLetter;
+        uint8_t word = flash_read_byte(&kLetterInfo[letter]);
         // Its slot, or Work::other for the other letters: the slot past the last one.
         Slot* const slots = b.v; // (a pointer: indexing the array past its end is undefined)
         num::Decimal& d = slots[word < kDecimalSlots ? word : kDecimalSlots].d;
