@@ -450,8 +450,10 @@ void run_once() {
         }
     }
     motion::poll();
-    if (p.wait != Wait::None) advance_wait();
+    // A line just read is executed at once when the planner has room, not one poll later: its
+    // `ok`, and so the sender's next line, come that much sooner.
     if (p.wait == Wait::None) read_line();
+    if (p.wait != Wait::None) advance_wait();
 }
 
 } // namespace app
