@@ -272,7 +272,6 @@ void run_gcode() {
     gcode::Outcome& o = p.o;
     static_assert(gcode::kCheckMode == 1, "p.check (0 or 1) is the flag");
     uint8_t r = gcode::execute(p.line, static_cast<uint8_t>(p.gflags | p.check), o);
-    if (o.move) motion::push_line(*o.move); // planned here, not under execute()'s frame
     if (r >= gcode::kRetryWhenAccepting) {
         p.wait = static_cast<Wait>(r - gcode::kRetryWhenAccepting + uint8_t(Wait::WhenAccepting));
     } else if (r == kOk && o.then != gcode::Then::Nothing) {
@@ -280,6 +279,11 @@ void run_gcode() {
     } else {
         finish(r);
     }
+    // Planned here, not under execute()'s frame, and after its `ok` is queued: the answer does
+    // not depend on the planning (push_line() prints nothing), and the sender's next line is
+    // then on its way while the planner works. (A wait set above is only looked at in a later
+    // run_once(), after this move is queued.)
+    if (o.move) motion::push_line(*o.move);
 }
 
 // A complete line: answer it, or start executing it.
