@@ -977,9 +977,11 @@ void report_modes() {
     out::word('M', m.spindle);
     out::word('M', m.coolant);
     out::word('T', g_state.tool);
-    out::str(LL_PSTR(" F"));
+    out::ch(' '); // (two characters: 1 B less than a string and its call)
+    out::ch('F');
     out::rate(g_state.feed);
-    out::str(LL_PSTR(" S"));
+    out::ch(' ');
+    out::ch('S');
     out::u32(g_state.spindle_speed);
     out::bracket_eol();
 }

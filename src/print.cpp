@@ -59,7 +59,8 @@ void line(const FlashChar* s) {
 }
 
 void bracket_eol() {
-    line(LL_PSTR("]"));
+    ch(']');
+    eol();
 }
 
 void u32(uint32_t v) {

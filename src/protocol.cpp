@@ -162,7 +162,8 @@ __attribute__((noinline)) void report_status() {
     }
     out::str(LL_PSTR("|FS:"));
     out::rate(motion::current_feed() * 1000u);
-    out::str(LL_PSTR(",0"));
+    out::ch(','); // (two characters: 1 B less than a string and its call)
+    out::ch('0');
     // WCO: in the first report after a reset, right after an offset changed, then every 10th
     // report (every 30th while moving), as GRBL 1.1h.
     if (gcode::g_state.wco_changed || p.wco_countdown == 0) {
@@ -173,7 +174,8 @@ __attribute__((noinline)) void report_status() {
     } else {
         --p.wco_countdown;
     }
-    out::line(LL_PSTR(">"));
+    out::ch('>');
+    out::eol();
 }
 
 // `$N=value`.
