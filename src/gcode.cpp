@@ -401,6 +401,24 @@ __attribute__((noinline)) int32_t add(int32_t a, int32_t b, uint8_t subtract = k
 __attribute__((noinline)) void copy_words(void* dst, const void* src, uint8_t words) {
     uint8_t* d = static_cast<uint8_t*>(dst);
     const uint8_t* s = static_cast<const uint8_t*>(src);
+#if defined(__AVR__)
+    // X and Z post-increment through the scratch register: the compiler's version kept a word in
+    // saved registers (or its pointer in Y), for 10 B and 10 cycles a call more.
+    asm volatile("1:\n\t"
+                 "ld  __tmp_reg__, Z+\n\t"
+                 "st  X+, __tmp_reg__\n\t"
+                 "ld  __tmp_reg__, Z+\n\t"
+                 "st  X+, __tmp_reg__\n\t"
+                 "ld  __tmp_reg__, Z+\n\t"
+                 "st  X+, __tmp_reg__\n\t"
+                 "ld  __tmp_reg__, Z+\n\t"
+                 "st  X+, __tmp_reg__\n\t"
+                 "dec %[n]\n\t"
+                 "brne 1b"
+                 : "+x"(d), "+z"(s), [n] "+r"(words)
+                 :
+                 : "memory");
+#else
     do {
         uint32_t v;
         memcpy(&v, s, sizeof(v));
@@ -408,6 +426,7 @@ __attribute__((noinline)) void copy_words(void* dst, const void* src, uint8_t wo
         d += sizeof(v);
         s += sizeof(v);
     } while (--words != 0);
+#endif
 }
 
 void set_end_modes(Modal& m) {
