@@ -69,17 +69,20 @@ const char* parse(const char* p, Decimal& out) {
 
 bool length_to_milli(const Decimal& d, bool inches, int32_t& out) {
     // ipart x unit + what the decimals make, with one multiplication and one range check.
-    uint16_t unit = 1000;
-    uint32_t limit = kInt32Max / 1000, decimals = d.frac + (d.sub >= 50 ? 1u : 0u);
+    // Below 2^22 (inches: 2^17), ipart x unit + decimals cannot wrap, and finish() refuses
+    // what exceeds INT32_MAX (from ipart 2147484, inches 84547, on); at or above it the value
+    // is refused at once. (A mask of the top half, not a 32-bit limit: fewer saved registers.)
+    uint16_t unit = 1000, top_mask = 0xFFC0;
+    uint32_t decimals = d.frac + (d.sub >= 50 ? 1u : 0u);
     if (inches) {
         // 25400 per inch; the five decimals are 1e-5 in = 0.254 units of the result.
         unit = 25400;
-        limit = kInt32Max / 25400;
+        top_mask = 0xFFFE;
         uint32_t frac5 =
             static_cast<uint32_t>(d.frac) * 100u + d.sub + ((d.flags & Decimal::kRound6) ? 1u : 0u);
         decimals = (frac5 * 254u + 500u) / 1000u;
     }
-    if (d.ipart > limit) return false;
+    if (static_cast<uint16_t>(d.ipart >> 16) & top_mask) return false;
     return finish(d.negative(), d.ipart * unit + decimals, out);
 }
 
