@@ -20,8 +20,8 @@ bool finish(bool negative, uint32_t magnitude, int32_t& out) {
 
 #if defined(__AVR__)
 // parse() on the chip, as one routine (the portable C below is the reference, which the host
-// tests check): three of them a G-code line, about 200 cycles each instead of 325 (no saved
-// register, no call). p in r24:r25 (then Z), &out in r22:r23 (then X); ipart in r18..r21 while the
+// tests check): three of them a G-code line, about 200 cycles each instead of 325 (nothing
+// saved or pushed). p in r24:r25 (then Z), &out in r22:r23 (then X); ipart in r18..r21 while the
 // integer part is read (x10 by the multiplier, r23 = 10 and r22 = 0 meanwhile), stored at the
 // point, then frac r18:r19, sub r20 and the place r21; flags r25, with the sign (0x40) and "a digit
 // was read" (0x80) until the end; the digit r24.
