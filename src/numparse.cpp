@@ -23,8 +23,8 @@ bool finish(bool negative, uint32_t magnitude, int32_t& out) {
 // tests check): three of them a G-code line, about 200 cycles each instead of 325 (nothing
 // saved or pushed). p in r24:r25 (then Z), &out in r22:r23 (then X); ipart in r18..r21 while the
 // integer part is read (x10 by the multiplier, r23 = 10 and r22 = 0 meanwhile), stored at the
-// point, then frac r18:r19, sub r20 and the place r21; flags r25, with the sign (0x40) and "a digit
-// was read" (0x80) until the end; the digit r24.
+// point, then frac r18:r19, sub r20 and the place r21; flags r25, with the sign (0x40), "a digit
+// was read" (0x80) and "a non-zero one" (0x20) until the end; the digit r24.
 asm(".section .text._ZN2ll3num5parseEPKcRNS0_7DecimalE,\"ax\",@progbits\n"
     ".global _ZN2ll3num5parseEPKcRNS0_7DecimalE\n"
     ".type _ZN2ll3num5parseEPKcRNS0_7DecimalE, @function\n"
@@ -54,8 +54,10 @@ asm(".section .text._ZN2ll3num5parseEPKcRNS0_7DecimalE,\"ax\",@progbits\n"
     "cpi  r24, 10\n"
     "brsh .Lpi_point\n"
     "adiw r30, 1\n"
-    "rcall .Lpi_digit\n"
-    "mov  r0, r18\n" // ipart 0 (a first or a leading zero digit): ipart = d, no x10
+    "ori  r25, 0x80\n" // a digit was read
+    "cpse r24, r1\n"
+    "ori  r25, 0x20\n" // a non-zero one
+    "mov  r0, r18\n"   // ipart 0 (a first or a leading zero digit): ipart = d, no x10
     "or   r0, r19\n"
     "or   r0, r20\n"
     "or   r0, r21\n"
@@ -111,7 +113,9 @@ asm(".section .text._ZN2ll3num5parseEPKcRNS0_7DecimalE,\"ax\",@progbits\n"
     "cpi  r24, 10\n"
     "brsh .Lpi_end\n"
     "adiw r30, 1\n"
-    "rcall .Lpi_digit\n"
+    "ori  r25, 0x80\n" // a digit was read
+    "cpse r24, r1\n"
+    "ori  r25, 0x20\n" // a non-zero one
     "cpi  r21, 5\n"
     "brsh .Lpi_beyond\n"
     "mov  r22, r24\n" // d x 1
@@ -155,6 +159,12 @@ asm(".section .text._ZN2ll3num5parseEPKcRNS0_7DecimalE,\"ax\",@progbits\n"
     ".Lpi_end:\n" // frac, sub, flags (ipart is stored)
     "sbrs r25, 7\n"
     "rjmp .Lpi_fail\n"
+    // The sign counts once a digit is not zero ("-0" is not negative).
+    "sbrc r25, 5\n"
+    "sbrs r25, 6\n"
+    "rjmp 9f\n"
+    "ori  r25, 1\n" // kNegative
+    "9:\n"
     "st   X+, r18\n"
     "st   X+, r19\n"
     "st   X+, r20\n"
@@ -166,14 +176,6 @@ asm(".section .text._ZN2ll3num5parseEPKcRNS0_7DecimalE,\"ax\",@progbits\n"
     "clr  r1\n"
     "clr  r24\n"
     "clr  r25\n"
-    "ret\n"
-    ".Lpi_digit:\n" // a digit was read; the sign counts once one is not zero ("-0" is not negative)
-    "ori  r25, 0x80\n"
-    "tst  r24\n"
-    "breq 5f\n"
-    "sbrc r25, 6\n"
-    "ori  r25, 1\n" // kNegative
-    "5:\n"
     "ret\n"
     ".size _ZN2ll3num5parseEPKcRNS0_7DecimalE, .-_ZN2ll3num5parseEPKcRNS0_7DecimalE\n"
     ".text\n");
