@@ -304,10 +304,10 @@ void dispatch() {
     } else if (p.alarm) {
         finish(kGcodeLock);
     } else {
-        // Parsed by advance_wait() once the planner has room (in the next run_once() when it has
-        // some now): when it is full, parsing now and again then would double the parse, a
-        // third of a short line's cost, and a streaming sender keeps the planner full. A line
-        // that would not move waits for that room too.
+        // Parsed by advance_wait() once the planner has room (right after this, in the same
+        // run_once(), when it has some now): when it is full, parsing now and again then would
+        // double the parse, a third of a short line's cost, and a streaming sender keeps the
+        // planner full. A line that would not move waits for that room too.
         p.wait = Wait::WhenAccepting;
     }
     p.len = 0;
