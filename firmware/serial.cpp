@@ -47,8 +47,8 @@ volatile uint8_t s_tx_active; // a "transmit complete" interrupt is still to com
 } // namespace ll
 
 // Interruptible tail of the receive interrupt: rt::filter() (realtime.h), then the ring. In
-// assembly: C's version saved r0, r1 and three more registers, and SREG through r0 (18 B and
-// 12 cycles a byte more); the hardware's DOR0 (a byte lost before this one) waits in T. Named
+// assembly: C's version saved r0, r1 and three more registers, and SREG through r0 (32 B and
+// about 25 cycles a byte more); the hardware's DOR0 (a byte lost before this one) waits in T. Named
 // __vector_* to keep its place in cmake/text_order.ld.
 extern "C" void __vector_rx_drain() __attribute__((naked, used, externally_visible));
 void __vector_rx_drain() {
