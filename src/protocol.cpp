@@ -162,7 +162,8 @@ __attribute__((noinline)) void report_status() {
     }
     out::str(LL_PSTR("|FS:"));
     out::rate(motion::current_feed() * 1000u);
-    out::str(LL_PSTR(",0"));
+    out::ch(','); // (two characters: 1 B less than a string and its call)
+    out::ch('0');
     // WCO: in the first report after a reset, right after an offset changed, then every 10th
     // report (every 30th while moving), as GRBL 1.1h.
     if (gcode::g_state.wco_changed || p.wco_countdown == 0) {
@@ -173,7 +174,8 @@ __attribute__((noinline)) void report_status() {
     } else {
         --p.wco_countdown;
     }
-    out::line(LL_PSTR(">"));
+    out::ch('>');
+    out::eol();
 }
 
 // `$N=value`.
@@ -272,7 +274,6 @@ void run_gcode() {
     gcode::Outcome& o = p.o;
     static_assert(gcode::kCheckMode == 1, "p.check (0 or 1) is the flag");
     uint8_t r = gcode::execute(p.line, static_cast<uint8_t>(p.gflags | p.check), o);
-    if (o.move) motion::push_line(*o.move); // planned here, not under execute()'s frame
     if (r >= gcode::kRetryWhenAccepting) {
         p.wait = static_cast<Wait>(r - gcode::kRetryWhenAccepting + uint8_t(Wait::WhenAccepting));
     } else if (r == kOk && o.then != gcode::Then::Nothing) {
@@ -280,6 +281,11 @@ void run_gcode() {
     } else {
         finish(r);
     }
+    // Planned here, not under execute()'s frame, and after its `ok` is queued: the answer does
+    // not depend on the planning (push_line() prints nothing), and the sender's next line is
+    // then on its way while the planner works. (A wait set above is only looked at in a later
+    // run_once(), after this move is queued.)
+    if (o.move) motion::push_line(*o.move);
 }
 
 // A complete line: answer it, or start executing it.
@@ -298,10 +304,10 @@ void dispatch() {
     } else if (p.alarm) {
         finish(kGcodeLock);
     } else {
-        // Parsed by advance_wait() once the planner has room (in the next run_once() when it has
-        // some now): when it is full, parsing now and again then would double the parse, a
-        // third of a short line's cost, and a streaming sender keeps the planner full. A line
-        // that would not move waits for that room too.
+        // Parsed by advance_wait() once the planner has room (right after this, in the same
+        // run_once(), when it has some now): when it is full, parsing now and again then would
+        // double the parse, a third of a short line's cost, and a streaming sender keeps the
+        // planner full. A line that would not move waits for that room too.
         p.wait = Wait::WhenAccepting;
     }
     p.len = 0;
@@ -324,32 +330,40 @@ void read_line() {
         if (!hal::serial_get(p.last)) return; // straight into p.last: no frame for it
         if (p.lost_after != 0 && --p.lost_after == 0) p.flags |= kLost;
         uint8_t c = p.last;
+        uint8_t f = p.flags;
+        // The common case first: in a line without flags (none in a comment), '-' to 'Z' but
+        // '/' and ';' (digits, '.', capitals) is kept as it is, without the tests below (about
+        // 20 cycles a byte).
+        if (f == 0 && static_cast<uint8_t>(c - '-') <= 'Z' - '-' && c != '/' && c != ';') {
+            goto keep;
+        }
         if (c == '\n' || c == '\r') {
             if (c == '\n' && prev == '\r') continue; // CR LF is one line end
             dispatch();
             return; // one line per run_once()
         }
-        uint8_t f = p.flags;
-        if (c == '\t') c = ' ';
-        if (c < 0x20 || c >= 0x7F) {
+        if (c == ' ' || c == '\t' || c == '/') {
+            // spaces and tabs, and block delete (ignored, as GRBL does), in comments too
+        } else if (c < 0x20 || c >= 0x7F) {
             f |= kBadByte; // GRBL drops such bytes and runs the rest; we refuse the line
         } else if (f & kInSemicolon) {
         } else if (f & kInParen) {
             if (c == ')') f &= static_cast<uint8_t>(~kInParen);
-        } else if (c == ' ' || c == '/') {
-            // spaces and tabs, and block delete (ignored, as GRBL does)
         } else if (c == '(') {
             f |= kInParen;
         } else if (c == ';') {
             f |= kInSemicolon;
-        } else if (p.len >= protocol::kLineMax) {
-            f |= kTooLong;
         } else {
             if (c >= 'a' && c <= 'z') c = static_cast<uint8_t>(c - ('a' - 'A'));
-            // Kept terminated: the pointer is at hand here (dispatch() would compute it).
-            char* at = p.line + p.len++;
-            at[0] = static_cast<char>(c);
-            at[1] = 0;
+        keep:
+            if (p.len >= protocol::kLineMax) {
+                f |= kTooLong;
+            } else {
+                // Kept terminated: the pointer is at hand here (dispatch() would compute it).
+                char* at = p.line + p.len++;
+                at[0] = static_cast<char>(c);
+                at[1] = 0;
+            }
         }
         p.flags = f;
     }
@@ -442,8 +456,10 @@ void run_once() {
         }
     }
     motion::poll();
-    if (p.wait != Wait::None) advance_wait();
+    // A line just read is executed at once when the planner has room, not one poll later: its
+    // `ok`, and so the sender's next line, come that much sooner.
     if (p.wait == Wait::None) read_line();
+    if (p.wait != Wait::None) advance_wait();
 }
 
 } // namespace app

@@ -1,6 +1,6 @@
 // Formatting of everything the firmware sends: GRBL's responses, reports and fixed-point values,
-// straight to hal::serial_put (no buffer, no printf, no division: digits come from subtracting
-// powers of ten).
+// straight to hal::serial_put (no line buffer, no printf; a number's digits come from the
+// library's 32-bit division, into a 10-byte buffer: reports are cold, flash is not).
 #pragma once
 
 #include <stdint.h>

@@ -16,7 +16,8 @@ enum : uint8_t {
 
 extern volatile uint8_t g_pending;
 
-/// Called by the receive interrupt for every byte. Returns true when the byte is a real-time
+/// Called for every received byte (the chip's receive interrupt has the same tests in assembly,
+/// firmware/serial.cpp: keep both in step). Returns true when the byte is a real-time
 /// command (it is then consumed here and never enters the receive buffer). Besides the four
 /// commands above, GRBL 1.1's extended real-time bytes (0x84 safety door, 0x85 jog cancel,
 /// 0x87 debug, 0x90-0x9D overrides, 0xA0-0xA1 accessories) are consumed and ignored: a sender
