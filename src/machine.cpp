@@ -22,14 +22,4 @@ void machine_build(Machine& m, const Settings& s) {
     m.min_period = step_timing::min_period(static_cast<uint16_t>(s.pulse_us * (kCpuHz / 1000000)));
 }
 
-uint8_t regulated_group(const Machine& m, const int32_t delta_steps[kAxes]) {
-    // A nonzero count has a nonzero byte: ORed bytewise (the 32-bit test would hold the count
-    // in four call-saved registers on the ATmega328P).
-    const uint8_t* b = reinterpret_cast<const uint8_t*>(delta_steps);
-    for (uint8_t a = 0; a < kAxes; ++a, b += 4) {
-        if ((b[0] | b[1] | b[2] | b[3]) != 0) return m.group_of[a];
-    }
-    return 0;
-}
-
 } // namespace ll

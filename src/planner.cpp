@@ -39,21 +39,21 @@ bool ratio_less(uint32_t n1, uint32_t d1, uint32_t n2, uint32_t d2) {
     if (n1 == n2) return d1 > d2;
     uint32_t l1, h1 = mul_wide(n1, d2, l1);
     uint32_t l2, h2 = mul_wide(n2, d1, l2);
-    return h1 != h2 ? h1 < h2 : l1 < l2;
+    return h1 < h2 || (h1 == h2 && l1 < l2);
 }
 
 // The axis with comp[a] > 0 whose lim[a] / comp[a] is the smallest (the first one on a tie),
 // kAxes when every comp[a] is 0.
 uint8_t tightest(const AxisSettings* ax, Limit which, const uint32_t comp[kAxes]) {
     uint8_t best = kAxes;
-    uint32_t best_lim = 0, best_comp = 0;
-    for (uint8_t a = 0; a < kAxes; ++a) {
-        const uint32_t c = comp[a], lim = ax[a].*which;
-        if (c == 0) continue;
-        if (best == kAxes || ratio_less(lim, c, best_lim, best_comp)) {
+    const uint32_t *best_lim = nullptr, *best_comp = nullptr;
+    for (uint8_t a = 0; a < kAxes; ++a, ++ax, ++comp) {
+        const uint32_t* lim = &(ax->*which);
+        if (*comp == 0) continue;
+        if (best == kAxes || ratio_less(*lim, *comp, *best_lim, *best_comp)) {
             best = a;
             best_lim = lim;
-            best_comp = c;
+            best_comp = comp;
         }
     }
     return best;
@@ -153,10 +153,9 @@ void move_limits(const Machine& m, const int32_t delta[kAxes], uint8_t group, Mo
 }
 
 void Planner::reset(const int32_t steps[kAxes]) {
-    head_ = 0;
-    count_ = 0;
-    curve_used_ = 0;
-    first_begun_ = 0;
+    // head_, count_, first_begun_, curve_used_: one run of bytes.
+    static_assert(offsetof(Planner, curve_used_) == offsetof(Planner, head_) + 3, "in order");
+    memset(&head_, 0, 4);
     memcpy(last_, steps, sizeof(last_));
     // The commanded position that matches the machine position, mm x1000 (after an abort the
     // machine is between targets; the next move's direction is taken from here): each axis'
@@ -185,7 +184,10 @@ __attribute__((noinline)) PlanBlock* Planner::at(uint8_t i) {
 //   v_junction^2 = a * delta * sin (1 + sin) / q.
 // Writing 1 - sin as q / (1 + sin) keeps full precision on nearly straight paths, where a
 // chain of short segments spends its time; |w| keeps it near reversals.
-uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
+// (Without tree PRE: gcc's partial redundancy elimination keeps values alive across the calls
+// here, a few bytes more.)
+__attribute__((optimize("no-move-loop-invariants", "no-tree-pre"))) uint32_t
+Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     const Machine& m = *m_; // loaded once
     uint32_t dc[kAxes];
     uint8_t moving = 0; // the axes of d
@@ -238,19 +240,22 @@ uint32_t Planner::junction2(const int32_t unit[kAxes], uint32_t limit) const {
     return min32(r.mulc(kMilli, -9).u32(), limit); // / 1000 (kMilli 2^-41), x 2^32
 }
 
-bool Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) {
-    bool moves = false;
+uint8_t Planner::open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]) {
+    uint8_t group = 0;
+    const uint8_t* g = m_->group_of;
     uint8_t* p = b.delta[0];
-    for (uint8_t a = 0; a < kAxes; ++a, p += 3) {
+    for (uint8_t a = 0; a < kAxes; ++a, p += 3, ++g) {
         const uint32_t v = static_cast<uint32_t>(target[a] - last_[a]);
         last_[a] = target[a];
         d[a] = static_cast<int32_t>(v);
-        if (v != 0) moves = true;
+        // The regulated group (seed §3.1, LinuxCNC/g2core rule): the group of the first moving
+        // axis in X, Y, Z, A, B, C order (never 0: an axis is in its own group).
+        if (v != 0 && group == 0) group = *g;
         p[0] = static_cast<uint8_t>(v);
         p[1] = static_cast<uint8_t>(v >> 8);
         p[2] = static_cast<uint8_t>(v >> 16);
     }
-    return moves;
+    return group;
 }
 
 // curve_shape() is one of the deepest stacks of the firmware (with stepping a curve: poll() ->
@@ -275,8 +280,7 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
     // stack of the firmware runs through here.
     PlanBlock& b = *at(count_);
     int32_t d[kAxes]; // steps, then the unit vector the move starts along (Q29)
-    const bool moves = open(b, target, d);
-    uint8_t group;
+    uint8_t group = open(b, target, d);
     uint8_t slot = 0; // 1 + the curve's slot
     CurveSlot* cs = nullptr;
     if (curve) {
@@ -305,11 +309,10 @@ bool Planner::add(const int32_t target[kAxes], const int32_t target_um[kAxes], u
         // Junctions from the tangents at both ends (w counts only when it is regulated).
         place(d, shape.start_dir, plane, cs->shaped.dirs);
     } else {
-        if (!moves) {
+        if (!group) { // nothing moves
             memcpy(last_um_, target_um, sizeof(last_um_));
             return false;
         }
-        group = regulated_group(m, d);
         {
             MoveLimits lim;
             move_limits(m, d, group, lim);
@@ -385,11 +388,16 @@ void Planner::recalculate() {
     PlanBlock* b = at(static_cast<uint8_t>(count_ - 1));
     uint32_t next_entry = 0;
     uint8_t pos = count_;
-    uint8_t from = 0; // where the forward pass starts
+    uint8_t from = 0;    // where the forward pass starts
+    uint8_t chain = 1;   // the last `chain - 1` moves entered at the next one's entry + dv2
+    uint8_t growing = 1; // no move entered at its maximum yet
     while (pos-- > first_begun_) {
         uint32_t v = add_sat(next_entry, b->dv2);
-        if (v >= b->v_max_entry2) {
+        if (v < b->v_max_entry2) {
+            chain = static_cast<uint8_t>(chain + growing);
+        } else {
             v = b->v_max_entry2;
+            growing = 0;
             if (first_begun_ && b->v_entry2 == v) {
                 from = pos;
                 break;
@@ -399,12 +407,19 @@ void Planner::recalculate() {
         next_entry = v;
         b = b == first ? last : b - 1;
     }
-    // Forward pass: no move can enter faster than the previous one can accelerate to.
+    // Forward pass: no move can enter faster than the previous one can accelerate to. A move of
+    // the chain whose entry this pass keeps lowers neither the next one (it enters below its
+    // entry + dv2) nor, by the same token, any later one: the pass stops there (in a chain of
+    // short moves, past the few accelerating from the move being executed).
     b = at(from);
     for (uint8_t n = static_cast<uint8_t>(count_ - from); n > 1; --n) {
         uint32_t reach = add_sat(b->v_entry2, b->dv2);
-        b = b == last ? first : b + 1;
-        if (b->v_entry2 > reach) b->v_entry2 = reach;
+        b = b == last ? first : b + 1; // n - 1 moves from the end
+        if (b->v_entry2 > reach) {
+            b->v_entry2 = reach;
+        } else if (n <= chain) {
+            break;
+        }
     }
 }
 

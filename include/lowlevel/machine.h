@@ -20,8 +20,4 @@ struct Machine {
 
 void machine_build(Machine& m, const Settings& s);
 
-/// The regulated group of a move (seed §3.1, LinuxCNC/g2core rule): the group of the first
-/// moving axis in X, Y, Z, A, B, C order. 0 when nothing moves.
-uint8_t regulated_group(const Machine& m, const int32_t delta_steps[kAxes]);
-
 } // namespace ll

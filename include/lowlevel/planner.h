@@ -138,8 +138,8 @@ class Planner {
     /// Keeps a line's length `len` (µm x 256) for spec_of_first() when it can (sets b.has_len).
     void keep_len(PlanBlock& b, uint32_t len);
     /// Writes the move from the last target to `target` (steps) into `b` and `d`; `target`
-    /// becomes the last target. Returns false when no axis moves.
-    bool open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]);
+    /// becomes the last target. Returns the move's regulated group, 0 when no axis moves.
+    uint8_t open(PlanBlock& b, const int32_t target[kAxes], int32_t d[kAxes]);
     /// A curve's slot: its length and parameters while its move is queued; before that, while
     /// the move is being queued, the curve's shape (shape_curve()). The length leads both (a
     /// common initial sequence): the shape's stays in place when the parameters replace the rest.
