@@ -232,20 +232,17 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
 void StepGen::prepare_profile(uint32_t v_entry2) {
     const uint32_t d1 = ref_len();
     const uint32_t remaining_ticks = d1 - origin_;
-    // From psi = 1 / (dv2 d_1), one division (dv2 = 2 a L, a = 128000 dv2 / len_q8):
-    // fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
-    //   l = v^2 rho / (2 a), rho = 256000 d_1 / len_q8 ticks per mm, so phi = d_1 / dv2 = psi
-    //   d_1^2;
-    // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD len_q8 sqrt(psi),
-    //   kD = 2 kSqrtCHalf / sqrt(2^7 128000).
-    Num t(d1); // scratch
-    Num psi(1);
-    psi.div(t.mul(dv2_));
+    // Fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t): l = v^2 rho /
+    // (2 a), rho = 256000 d_1 / len_q8 ticks per mm, dv2 = 2 a L, a = 128000 dv2 / len_q8, so
+    //   phi = d_1 / dv2 (one division);
+    // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD r sqrt(phi), with r = len_q8 / d_1
+    // (µm x 256 per tick) and kD = 2 kSqrtCHalf / sqrt(2^7 128000).
     Num& phi = a_per_v2_; // phi in place: shifted to the profile's scale below
-    phi = psi;
-    phi.mul(d1).mul(d1);
-    Num& dn = psi;                                  // psi is not needed any more: D in its place
-    dn.sqrt().mul(len_q8_).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
+    phi.set(d1).div(dv2_);
+    Num r(len_q8_);
+    r.div(d1);
+    Num dn = phi;                             // D in its own room
+    dn.sqrt().mul(r).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
     uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2_)), remaining_ticks);
@@ -264,7 +261,7 @@ void StepGen::prepare_profile(uint32_t v_entry2) {
     set_a_exit();
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
-    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(t.set(feed_).mul(d1)).u32();
+    prof_.cruise = r.mulc(kCruiseNum << 2, -2).div(feed_).u32(); // kCruiseNum r / feed
     root_valid_ = false;
     stopped_ = false;
     // The first segment: one tick from rest; a line entering at speed keeps the length of the
@@ -291,9 +288,8 @@ void StepGen::set_a_exit() {
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
 }
 
-void StepGen::set_exit(uint32_t v_exit2) {
+void StepGen::raise_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
-    if (v_exit2 == v_exit2_) return; // called at every poll: usually no change
     // end deceleration already begun (the point from the profile in force: set_exit() is the
     // only reader, and its test is rarely reached)
     if (x2_now() >= profile_x2_decel(prof_)) return;

@@ -98,7 +98,11 @@ class StepGen {
 
     /// The planner raised the exit speed of the current move. Ignored once the end deceleration
     /// has begun (the seed's profile never accelerates at the end of a move).
-    void set_exit(uint32_t v_exit2);
+    /// (Called at every poll, usually with no change: that test inline, before the call and the
+    /// registers it saves.)
+    void set_exit(uint32_t v_exit2) {
+        if (v_exit2 != v_exit2_) raise_exit(v_exit2);
+    }
 
     /// Feed hold: from the next segment on, decelerate to a stop (possibly across moves).
     void hold();
@@ -144,6 +148,8 @@ class StepGen {
     }
 
   private:
+    /// set_exit() with a new exit.
+    void raise_exit(uint32_t v_exit2);
     bool begin_curve(const MoveSpec& spec);
     /// A line's part of begin() (out of line: begin()'s frame, under begin_curve(), stays
     /// small).
