@@ -269,18 +269,9 @@ void StepGen::prepare_profile(uint32_t v_entry2) {
     // so does not spend a segment on one tick (a 0.1 mm line has only 6 to 8). A curve sets 1
     // when it ends: its segment lengths count samples, not ticks.
     if (v_entry2 == 0 || seg_len_ == 0) seg_len_ = 1;
-    if (!curve_) {
-        // The runs' periods at cruise, for fill_line (one product per axis set and move).
-        // The longest is K_max's (mul_shr() is monotonic in the factor).
-        const uint8_t sets = static_cast<uint8_t>(1u << (ln_.g.m - 1));
-        uint32_t longest = 0;
-        for (uint8_t sub = 0; sub < sets; ++sub) {
-            const uint32_t p = mul_shr(prof_.cruise, ln_.k[sub], 20);
-            ln_.cruise_period[sub] = p;
-            if (p > longest) longest = p;
-        }
-        ln_.cruise_seg = next_segment(prof_.cruise, longest, prof_.a_cruise);
-    }
+    // The runs' periods at cruise: computed by fill_line() at the first segment at cruise (a
+    // chain of short moves limited by the look-ahead never reaches it).
+    if (!curve_) ln_.cruise_seg = 0;
 }
 
 void StepGen::set_a_exit() {
@@ -539,6 +530,18 @@ void StepGen::fill_line(RunQueue& q) {
         const uint32_t d = corr ? less(delta, corr) : delta;
         // At cruise (most segments of a job) the periods are the move's constants.
         const bool at_cruise = delta == prof_.cruise;
+        if (at_cruise && ln_.cruise_seg == 0) {
+            // The runs' periods at cruise (one product per axis set and move) and the segment
+            // length there. The longest is K_max's (mul_shr() is monotonic in the factor).
+            const uint8_t sets = static_cast<uint8_t>(1u << (ln_.g.m - 1));
+            uint32_t longest = 0;
+            for (uint8_t sub = 0; sub < sets; ++sub) {
+                const uint32_t p = mul_shr(delta, ln_.k[sub], 20);
+                ln_.cruise_period[sub] = p;
+                if (p > longest) longest = p;
+            }
+            ln_.cruise_seg = next_segment(delta, longest, prof_.a_cruise);
+        }
         const bool constants = at_cruise && corr == 0;
         uint32_t sum = 0;
         for (const MicroRun* r = runs; n; --n, ++r) {

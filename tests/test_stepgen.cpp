@@ -150,6 +150,33 @@ TEST(StepGen, ShortLinesAtSpeedAreProducedInOneSegmentEach) {
     }
 }
 
+TEST(StepGen, CruisePeriodsAreTheMovesOwnWhenCruiseIsReachedMidMove) {
+    // The periods at cruise are computed at a move's first segment at cruise, not when it
+    // begins (a chain of short moves limited by the look-ahead never cruises). A move that
+    // reaches cruise after accelerating must use its own, not those of the move before it (which
+    // cruised from its first segment, at another feed).
+    lltest::Machine m{80, 80};
+    ll::StepGen gen{};
+    gen.configure(&m.lengths, 64);
+    for (double feed : {3000.0, 1200.0, 2400.0}) {
+        const bool from_rest = feed != 3000.0;
+        auto segs =
+            lltest::run_segments(gen, m.move({4000, 1500}, feed, 1000, from_rest ? 0 : feed, feed));
+        ASSERT_GE(segs.size(), 4u) << "F" << feed;
+        const uint32_t cruise = gen.profile().cruise;
+        // cycles of one step of the set of sorted positions (mask 1: X, 3: X and Y)
+        auto want = [&](uint8_t idx) { return (ll::mul_shr(cruise, gen.k(idx), 20) + 128) >> 8; };
+        EXPECT_NEAR(cruise / 256.0, 16e6 * 60 / (feed * 80) * std::hypot(4000, 1500) / 4000, 1.0);
+        // the last segments are at cruise (the exit is the cruise speed)
+        for (size_t i = segs.size() - 3; i < segs.size(); ++i) {
+            for (const auto& r : segs[i]) {
+                ASSERT_TRUE(r.steps == 1 || r.steps == 3) << "F" << feed;
+                EXPECT_EQ(r.period, want(r.steps == 1 ? 0 : 1)) << "F" << feed << " segment " << i;
+            }
+        }
+    }
+}
+
 TEST(StepGen, MovesEndExactlyOnTheirTargetWithEveryAxisStepCounted) {
     std::mt19937 rng(11);
     lltest::Machine m{80, 80, 400, 40};

@@ -243,7 +243,7 @@ class StepGen {
         uint8_t lens_set[1u << (kAxes - 1)];       ///< the axis set each length is for
         uint32_t k[1u << (kAxes - 1)];             ///< K table, Q20 (see k())
         uint32_t cruise_period[1u << (kAxes - 1)]; ///< K * Delta_1 at cruise, cycles x 256
-        uint8_t cruise_seg;                        ///< segment length at cruise
+        uint8_t cruise_seg; ///< segment length at cruise (0: cruise_period not computed yet)
     };
     struct CurveState {
         uint32_t ref_um;     ///< its length, µm (the profile's reference length)
