@@ -127,6 +127,7 @@ __attribute__((always_inline)) inline void StepGen::build_k_table(uint8_t group)
     // is no set (mask < 2^kAxes).
     if (!lens_valid_) {
         for (uint8_t& set : ln_.lens_set) set = 0xFF;
+        ln_.feed = 0; // (no feed: per_feed is not valid either)
     }
     lens_valid_ = true;
     uint32_t* lens = ln_.lens;
@@ -261,7 +262,18 @@ void StepGen::prepare_profile(uint32_t v_entry2) {
     set_a_exit();
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
-    prof_.cruise = r.mulc(kCruiseNum << 2, -2).div(feed_).u32(); // kCruiseNum r / feed
+    // kCruiseNum r / feed, with kCruiseNum / feed kept from the line before when the feed is the
+    // same (a chain of lines mostly is): a product instead of a division.
+    Num here; // (a curve's: its state holds no cache)
+    Num* per_feed = &here;
+    bool fresh = true;
+    if (!curve_) {
+        per_feed = &ln_.per_feed;
+        fresh = ln_.feed != feed_;
+        ln_.feed = feed_;
+    }
+    if (fresh) per_feed->set(kCruiseNum << 2, -2).div(feed_);
+    prof_.cruise = r.mul(*per_feed).u32();
     root_valid_ = false;
     stopped_ = false;
     // The first segment: one tick from rest; a line entering at speed keeps the length of the
@@ -281,9 +293,15 @@ void StepGen::set_a_exit() {
 
 void StepGen::raise_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
-    // end deceleration already begun (the point from the profile in force: set_exit() is the
-    // only reader, and its test is rarely reached)
-    if (x2_now() >= profile_x2_decel(prof_)) return;
+    // End deceleration already begun: the profile in force is on its end line where the last
+    // segment ended, A(x) = A_exit + s (d - x) <= start(x) (profile_a(), which is that minimum;
+    // the same test as x >= profile_x2_decel(), in A, without its variable shifts).
+    const uint32_t x2 = x2_now();
+    const uint32_t to_go2 = 2 * prof_.d - x2;
+    if (to_go2 > 2 * prof_.d) return; // (a curve's samples may run past its length)
+    if (profile_a(prof_, x2) >=
+        add_sat(prof_.a_exit, shl_sat(to_go2, static_cast<uint8_t>(prof_.log_s - 1))))
+        return;
     v_exit2_ = v_exit2;
     set_a_exit();
 }

@@ -244,6 +244,10 @@ class StepGen {
         uint32_t k[1u << (kAxes - 1)];             ///< K table, Q20 (see k())
         uint32_t cruise_period[1u << (kAxes - 1)]; ///< K * Delta_1 at cruise, cycles x 256
         uint8_t cruise_seg; ///< segment length at cruise (0: cruise_period not computed yet)
+        // kCruiseNum / feed for the feed of the last line (prepare_profile()), kept with the step
+        // lengths (0: none).
+        uint32_t feed;
+        Num per_feed;
     };
     struct CurveState {
         uint32_t ref_um;     ///< its length, µm (the profile's reference length)
