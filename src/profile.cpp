@@ -6,13 +6,14 @@ namespace ll {
 
 uint32_t profile_a(const Profile& p, uint32_t x2) {
 #if defined(__AVR__)
-    // r16 marked as used: with it the saved registers are one run (r4..r17), which -mcall-prologues
-    // saves through its shared routines, not 15 pushes and pops (-44 B; 2 B of stack, 34 cycles a
-    // segment).
-    asm volatile("" ::: "r16");
+    // r16 and Y marked as used: with them the saved registers are one run (r4..r17, r28, r29),
+    // which -mcall-prologues saves through its shared routines, not 15 pushes and pops (-44 B).
+    asm volatile("" ::: "r16", "r28", "r29");
 #endif
     const uint8_t half = static_cast<uint8_t>(p.log_s - 1); // s * x2 / 2 = x2 << half
-    uint32_t travelled = shl_sat(x2, half);
+    // (Plain shifts, not shl_sat()'s calls: s d <= 2^31 (the step generator picks s so), and x2
+    // passes 2 d by a curve's last samples at most, so neither shift can overflow.)
+    uint32_t travelled = x2 << half;
     // start(x): from A_entry towards A_cruise, clamped there (compared before adding: no
     // overflow to saturate).
     const bool up = p.a_entry <= p.a_cruise;
@@ -21,7 +22,7 @@ uint32_t profile_a(const Profile& p, uint32_t x2) {
         start = up ? p.a_entry + travelled : p.a_entry - travelled;
     // min(start, A_exit + s (d - x)), the same way.
     uint32_t to_go2 = 2 * p.d >= x2 ? 2 * p.d - x2 : 0;
-    uint32_t to_go = shl_sat(to_go2, half);
+    uint32_t to_go = to_go2 << half;
     return start <= p.a_exit || to_go >= start - p.a_exit ? start : p.a_exit + to_go;
 }
 
