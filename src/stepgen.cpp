@@ -299,9 +299,8 @@ void StepGen::raise_exit(uint32_t v_exit2) {
     const uint32_t x2 = x2_now();
     const uint32_t to_go2 = 2 * prof_.d - x2;
     if (to_go2 > 2 * prof_.d) return; // (a curve's samples may run past its length)
-    if (profile_a(prof_, x2) >=
-        add_sat(prof_.a_exit, shl_sat(to_go2, static_cast<uint8_t>(prof_.log_s - 1))))
-        return;
+    // (A_exit < 2^31 and s (d - x) <= s d <= 2^31: no overflow, as in profile_a())
+    if (profile_a(prof_, x2) >= prof_.a_exit + (to_go2 << (prof_.log_s - 1))) return;
     v_exit2_ = v_exit2;
     set_a_exit();
 }
