@@ -326,7 +326,7 @@ uint32_t StepGen::speed2() const {
 }
 
 void StepGen::pushed_position(int32_t out[kAxes]) const {
-    memcpy(out, start_, sizeof(start_));
+    if (out != start_) memcpy(out, start_, sizeof(start_)); // (begin(): in place)
     if (curve_) {
         for (uint8_t k = 0; k < 3; ++k) out[cv_.axes[k]] = cv_.w.pos[k];
         return;
