@@ -264,16 +264,16 @@ void StepGen::prepare_profile(uint32_t v_entry2) {
     // Exact cruise wait of the reference axis along the line: once per move.
     // kCruiseNum r / feed, with kCruiseNum / feed kept from the line before when the feed is the
     // same (a chain of lines mostly is): a product instead of a division.
-    Num here; // (a curve's: its state holds no cache)
-    Num* per_feed = &here;
-    bool fresh = true;
-    if (!curve_) {
-        per_feed = &ln_.per_feed;
-        fresh = ln_.feed != feed_;
-        ln_.feed = feed_;
+    if (curve_) { // (its state holds no cache)
+        r.mulc(kCruiseNum << 2, -2).div(feed_);
+    } else {
+        if (ln_.feed != feed_) {
+            ln_.feed = feed_;
+            ln_.per_feed.set(kCruiseNum << 2, -2).div(feed_);
+        }
+        r.mul(ln_.per_feed);
     }
-    if (fresh) per_feed->set(kCruiseNum << 2, -2).div(feed_);
-    prof_.cruise = r.mul(*per_feed).u32();
+    prof_.cruise = r.u32();
     root_valid_ = false;
     stopped_ = false;
     // The first segment: one tick from rest; a line entering at speed keeps the length of the
@@ -484,7 +484,14 @@ __attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t
         // shift a doubling (it stays below 2^24: no overflow).
         constexpr uint32_t kTarget = static_cast<uint32_t>(kSegmentCycles) << 8;
         constexpr uint32_t kLeast = static_cast<uint32_t>(kMinSegmentCycles) << 8;
-        const uint32_t l = a >> prof_.log_s; // ticks from rest
+        // ticks from rest, a >> log_s (8 of the usual 9 as a byte move, not 8 turns of a loop)
+        uint32_t l = a;
+        uint8_t log_s = prof_.log_s;
+        if (log_s & 8) { // (log_s <= 9)
+            l >>= 8;
+            log_s &= 7;
+        }
+        l >>= log_s;
         const bool steady = l >= (longest >> 6) + 64;
         uint8_t need = 16; // l wanted for a doubling below 8 ticks: 16 next
         while (next < 16 && delta < kTarget) {

@@ -83,9 +83,9 @@ inline bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
         // << (kLineUnit - k) (S_j <= 2^k: no overflow), 16 of it as a word move: a short line
         // shifts by about 20, 20 turns of a 32-bit loop (shl_sat())
         uint8_t up = static_cast<uint8_t>(kLineUnit - k);
-        if (up >= 16) {
+        if (up & 16) { // (up <= kLineUnit - 3 < 32)
             slope <<= 16;
-            up = static_cast<uint8_t>(up - 16);
+            up &= 15;
         }
         g.slope[j] = slope << up;
     }
