@@ -263,6 +263,9 @@ class StepGen {
         LineState ln_;
         CurveState cv_;
     };
+    // The line state's caches (step lengths, kCruiseNum / feed) take room the curve state
+    // leaves: no static RAM of their own on the chip's 4 axes.
+    static_assert(kAxes != 4 || sizeof(LineState) <= sizeof(CurveState), "caches in spare room");
     int32_t start_[kAxes]; ///< position where the current (or last) move started, steps
     // Duration of each queued run in 1024-cycle units (saturated), by queue slot: keeps the
     // horizon without any help from the interrupt.
