@@ -127,6 +127,7 @@ __attribute__((always_inline)) inline void StepGen::build_k_table(uint8_t group)
     // is no set (mask < 2^kAxes).
     if (!lens_valid_) {
         for (uint8_t& set : ln_.lens_set) set = 0xFF;
+        ln_.feed = 0; // (no feed: per_feed is not valid either)
     }
     lens_valid_ = true;
     uint32_t* lens = ln_.lens;
@@ -232,20 +233,17 @@ bool StepGen::begin_curve(const MoveSpec& spec) {
 void StepGen::prepare_profile(uint32_t v_entry2) {
     const uint32_t d1 = ref_len();
     const uint32_t remaining_ticks = d1 - origin_;
-    // From psi = 1 / (dv2 d_1), one division (dv2 = 2 a L, a = 128000 dv2 / len_q8):
-    // fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t):
-    //   l = v^2 rho / (2 a), rho = 256000 d_1 / len_q8 ticks per mm, so phi = d_1 / dv2 = psi
-    //   d_1^2;
-    // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD len_q8 sqrt(psi),
-    //   kD = 2 kSqrtCHalf / sqrt(2^7 128000).
-    Num t(d1); // scratch
-    Num psi(1);
-    psi.div(t.mul(dv2_));
+    // Fictive distance from rest per (mm/min)^2, reference ticks (seed §4.5 l_0^t): l = v^2 rho /
+    // (2 a), rho = 256000 d_1 / len_q8 ticks per mm, dv2 = 2 a L, a = 128000 dv2 / len_q8, so
+    //   phi = d_1 / dv2 (one division);
+    // D at s = 2: 2 kSqrtCHalf sqrt(2 len_um / (a d_1)) = kD r sqrt(phi), with r = len_q8 / d_1
+    // (µm x 256 per tick) and kD = 2 kSqrtCHalf / sqrt(2^7 128000).
     Num& phi = a_per_v2_; // phi in place: shifted to the profile's scale below
-    phi = psi;
-    phi.mul(d1).mul(d1);
-    Num& dn = psi;                                  // psi is not needed any more: D in its place
-    dn.sqrt().mul(len_q8_).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
+    phi.set(d1).div(dv2_);
+    Num r(len_q8_);
+    r.div(d1);
+    Num dn = phi;                             // D in its own room
+    dn.sqrt().mul(r).mulc(0xA5BA6827ul, -11); // kD = 1357645.0195
     // Largest scale s = 2 * 4^m (m <= 4) that keeps every A below 2^31 (l_max << (2m + 1)
     // <= 2^31) and D below 2^32 - 1 (D grows as sqrt(s) = 2^m sqrt(2)).
     uint32_t l_max = add_sat(phi.of(max3(v_entry2, v_nominal2_, v_exit2_)), remaining_ticks);
@@ -264,7 +262,18 @@ void StepGen::prepare_profile(uint32_t v_entry2) {
     set_a_exit();
     prof_.d_num = dn.shift(static_cast<int8_t>(m)).u32();
     // Exact cruise wait of the reference axis along the line: once per move.
-    prof_.cruise = Num(len_q8_).mulc(kCruiseNum << 2, -2).div(t.set(feed_).mul(d1)).u32();
+    // kCruiseNum r / feed, with kCruiseNum / feed kept from the line before when the feed is the
+    // same (a chain of lines mostly is): a product instead of a division.
+    if (curve_) { // (its state holds no cache)
+        r.mulc(kCruiseNum << 2, -2).div(feed_);
+    } else {
+        if (ln_.feed != feed_) {
+            ln_.feed = feed_;
+            ln_.per_feed.set(kCruiseNum << 2, -2).div(feed_);
+        }
+        r.mul(ln_.per_feed);
+    }
+    prof_.cruise = r.u32();
     root_valid_ = false;
     stopped_ = false;
     // The first segment: one tick from rest; a line entering at speed keeps the length of the
@@ -272,18 +281,9 @@ void StepGen::prepare_profile(uint32_t v_entry2) {
     // so does not spend a segment on one tick (a 0.1 mm line has only 6 to 8). A curve sets 1
     // when it ends: its segment lengths count samples, not ticks.
     if (v_entry2 == 0 || seg_len_ == 0) seg_len_ = 1;
-    if (!curve_) {
-        // The runs' periods at cruise, for fill_line (one product per axis set and move).
-        // The longest is K_max's (mul_shr() is monotonic in the factor).
-        const uint8_t sets = static_cast<uint8_t>(1u << (ln_.g.m - 1));
-        uint32_t longest = 0;
-        for (uint8_t sub = 0; sub < sets; ++sub) {
-            const uint32_t p = mul_shr(prof_.cruise, ln_.k[sub], 20);
-            ln_.cruise_period[sub] = p;
-            if (p > longest) longest = p;
-        }
-        ln_.cruise_seg = next_segment(prof_.cruise, longest, prof_.a_cruise);
-    }
+    // The runs' periods at cruise: computed by fill_line() at the first segment at cruise (a
+    // chain of short moves limited by the look-ahead never reaches it).
+    if (!curve_) ln_.cruise_seg = 0;
 }
 
 void StepGen::set_a_exit() {
@@ -291,12 +291,16 @@ void StepGen::set_a_exit() {
     prof_.a_exit = a > prof_.a_cruise ? prof_.a_cruise : a;
 }
 
-void StepGen::set_exit(uint32_t v_exit2) {
+void StepGen::raise_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
-    if (v_exit2 == v_exit2_) return; // called at every poll: usually no change
-    // end deceleration already begun (the point from the profile in force: set_exit() is the
-    // only reader, and its test is rarely reached)
-    if (x2_now() >= profile_x2_decel(prof_)) return;
+    // End deceleration already begun: the profile in force is on its end line where the last
+    // segment ended, A(x) = A_exit + s (d - x) <= start(x) (profile_a(), which is that minimum;
+    // the same test as x >= profile_x2_decel(), in A, without its variable shifts).
+    const uint32_t x2 = x2_now();
+    const uint32_t to_go2 = 2 * prof_.d - x2;
+    if (to_go2 > 2 * prof_.d) return; // (a curve's samples may run past its length)
+    // (A_exit < 2^31 and s (d - x) <= s d <= 2^31: no overflow, as in profile_a())
+    if (profile_a(prof_, x2) >= prof_.a_exit + (to_go2 << (prof_.log_s - 1))) return;
     v_exit2_ = v_exit2;
     set_a_exit();
 }
@@ -322,7 +326,7 @@ uint32_t StepGen::speed2() const {
 }
 
 void StepGen::pushed_position(int32_t out[kAxes]) const {
-    memcpy(out, start_, sizeof(start_));
+    if (out != start_) memcpy(out, start_, sizeof(start_)); // (begin(): in place)
     if (curve_) {
         for (uint8_t k = 0; k < 3; ++k) out[cv_.axes[k]] = cv_.w.pos[k];
         return;
@@ -480,7 +484,14 @@ __attribute__((noinline)) uint8_t StepGen::next_segment(uint32_t delta, uint32_t
         // shift a doubling (it stays below 2^24: no overflow).
         constexpr uint32_t kTarget = static_cast<uint32_t>(kSegmentCycles) << 8;
         constexpr uint32_t kLeast = static_cast<uint32_t>(kMinSegmentCycles) << 8;
-        const uint32_t l = a >> prof_.log_s; // ticks from rest
+        // ticks from rest, a >> log_s (8 of the usual 9 as a byte move, not 8 turns of a loop)
+        uint32_t l = a;
+        uint8_t log_s = prof_.log_s;
+        if (log_s & 8) { // (log_s <= 9)
+            l >>= 8;
+            log_s &= 7;
+        }
+        l >>= log_s;
         const bool steady = l >= (longest >> 6) + 64;
         uint8_t need = 16; // l wanted for a doubling below 8 ticks: 16 next
         while (next < 16 && delta < kTarget) {
@@ -543,6 +554,18 @@ void StepGen::fill_line(RunQueue& q) {
         const uint32_t d = corr ? less(delta, corr) : delta;
         // At cruise (most segments of a job) the periods are the move's constants.
         const bool at_cruise = delta == prof_.cruise;
+        if (at_cruise && ln_.cruise_seg == 0) {
+            // The runs' periods at cruise (one product per axis set and move) and the segment
+            // length there. The longest is K_max's (mul_shr() is monotonic in the factor).
+            const uint8_t sets = static_cast<uint8_t>(1u << (ln_.g.m - 1));
+            uint32_t longest = 0;
+            for (uint8_t sub = 0; sub < sets; ++sub) {
+                const uint32_t p = mul_shr(delta, ln_.k[sub], 20);
+                ln_.cruise_period[sub] = p;
+                if (p > longest) longest = p;
+            }
+            ln_.cruise_seg = next_segment(delta, longest, prof_.a_cruise);
+        }
         const bool constants = at_cruise && corr == 0;
         uint32_t sum = 0;
         for (const MicroRun* r = runs; n; --n, ++r) {

@@ -6,6 +6,7 @@
 #include <map>
 #include <random>
 
+#include "lowlevel/curve.h"
 #include "motion_util.h"
 
 namespace {
@@ -147,6 +148,108 @@ TEST(StepGen, ShortLinesAtSpeedAreProducedInOneSegmentEach) {
         auto segs = lltest::run_segments(gen, m.move({8, dy}, 3000, 1000, 3000, 3000));
         ASSERT_EQ(segs.size(), 1u) << "dy " << dy;
         EXPECT_EQ(ticks(segs[0]), 8);
+    }
+}
+
+TEST(StepGen, CruisePeriodsAreTheMovesOwnWhenCruiseIsReachedMidMove) {
+    // The periods at cruise are computed at a move's first segment at cruise, not when it
+    // begins (a chain of short moves limited by the look-ahead never cruises). A move that
+    // reaches cruise after accelerating must use its own, not those of the move before it (which
+    // cruised from its first segment, at another feed).
+    lltest::Machine m{80, 80};
+    ll::StepGen gen{};
+    gen.configure(&m.lengths, 64);
+    for (double feed : {3000.0, 1200.0, 2400.0}) {
+        const bool from_rest = feed != 3000.0;
+        auto segs =
+            lltest::run_segments(gen, m.move({4000, 1500}, feed, 1000, from_rest ? 0 : feed, feed));
+        ASSERT_GE(segs.size(), 4u) << "F" << feed;
+        const uint32_t cruise = gen.profile().cruise;
+        // cycles of one step of the set of sorted positions (mask 1: X, 3: X and Y)
+        auto want = [&](uint8_t idx) { return (ll::mul_shr(cruise, gen.k(idx), 20) + 128) >> 8; };
+        EXPECT_NEAR(cruise / 256.0, 16e6 * 60 / (feed * 80) * std::hypot(4000, 1500) / 4000, 1.0);
+        // the last segments are at cruise (the exit is the cruise speed)
+        for (size_t i = segs.size() - 3; i < segs.size(); ++i) {
+            for (const auto& r : segs[i]) {
+                ASSERT_TRUE(r.steps == 1 || r.steps == 3) << "F" << feed;
+                EXPECT_EQ(r.period, want(r.steps == 1 ? 0 : 1)) << "F" << feed << " segment " << i;
+            }
+        }
+    }
+}
+
+TEST(StepGen, CruiseWaitKeptForTheFeedIsTheMovesOwnAfterAFeedChangeOrACurve) {
+    // kCruiseNum / feed is kept from one line to the next while the feed is the same (a chain of
+    // lines): each line's cruise wait must still be what a fresh generator computes for it, after
+    // a line at another feed and after a curve (whose state takes the room of the kept value).
+    lltest::Machine m{80, 80};
+    ll::Num um_q8[ll::kAxes];
+    for (auto& n : um_q8) n = ll::Num(256000 / 80);
+    ll::CurveParams c{};
+    c.kind = ll::kCurveArc;
+    c.clockwise = 1;
+    c.a_um[0] = c.b_um[0] = c.b_um[1] = 2000;
+    ll::CurveShape shape;
+    ASSERT_TRUE(ll::curve_shape(c, 0, false, shape));
+    ll::StepGen gen{};
+    gen.configure(&m.lengths, 64, um_q8);
+    int lines = 0;
+    for (double feed : {3000.0, 3000.0, -3000.0, 3000.0, 1200.0, 1200.0, 3000.0}) {
+        gen.clear_queue_time(); // run_move() starts from an empty queue at slot 0
+        if (feed < 0) {         // a full circle at that feed, back where it started
+            ll::MoveSpec arc = m.move({0, 0}, -feed, 1000, 0, 0, 0x3);
+            arc.len_q8 = shape.len_q8;
+            arc.curve = &c;
+            ASSERT_FALSE(lltest::run_move(gen, arc).empty());
+            continue;
+        }
+        const ll::MoveSpec spec = m.move({70 + lines, 9 + 3 * lines}, feed, 1000, feed, feed);
+        ++lines;
+        ll::StepGen fresh{};
+        fresh.configure(&m.lengths, 64, um_q8);
+        ASSERT_TRUE(fresh.begin(spec));
+        ASSERT_FALSE(lltest::run_move(gen, spec).empty());
+        EXPECT_EQ(gen.profile().cruise, fresh.profile().cruise) << "line " << lines << " F" << feed;
+        EXPECT_EQ(gen.profile().d_num, fresh.profile().d_num) << "line " << lines;
+    }
+}
+
+TEST(StepGen, RaisedExitIsTakenUntilTheEndDecelerationBegins) {
+    // The planner raises the exit of the move in progress as it plans the next one: taken while
+    // the profile has not reached its end line, ignored once the end deceleration has begun (the
+    // seed's profile never accelerates at the end of a move).
+    lltest::Machine m{80, 80};
+    for (bool late : {false, true}) {
+        ll::StepGen gen{};
+        gen.configure(&m.lengths, 64);
+        ASSERT_TRUE(gen.begin(m.move({800, 300}, 3000, 1000, 0, 0)));
+        const uint32_t a_exit = gen.profile().a_exit;
+        bool raised = false;
+        ll::RunQueue q;
+        while (gen.active()) {
+            q.clear();
+            gen.clear_queue_time();
+            gen.fill(q);
+            if (raised || !gen.active()) continue;
+            const uint32_t x2 = 2 * (gen.length() - gen.remaining());
+            if ((x2 >= ll::profile_x2_decel(gen.profile())) != late) continue;
+            gen.set_exit(1500 * 1500);
+            raised = true;
+            if (late) {
+                EXPECT_EQ(gen.profile().a_exit, a_exit) << "x2 " << x2;
+            } else {
+                EXPECT_GT(gen.profile().a_exit, a_exit) << "x2 " << x2;
+            }
+        }
+        EXPECT_TRUE(raised) << "late " << late;
+        // the speed of the last segment (at its midpoint): near 1500 mm/min when the raise was
+        // taken, near rest otherwise
+        const double v = std::sqrt(gen.speed2());
+        if (late) {
+            EXPECT_LT(v, 300.0);
+        } else {
+            EXPECT_NEAR(v, 1500.0, 45.0);
+        }
     }
 }
 

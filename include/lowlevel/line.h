@@ -79,9 +79,15 @@ inline bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
     for (uint8_t j = 1; j < g.m; ++j) {
         // round(d_j * 2^k / d_1) = floor((2 d_j * 2^k / d_1 + 1) / 2), then in units of
         // 2^(kLineUnit - k) (the same value, aligned: line_advance shifts by a constant).
-        uint32_t twice = div_frac(g.dist[j], d1, static_cast<uint8_t>(k + 1));
-        g.slope[j] =
-            shl_sat((twice + 1) >> 1, static_cast<uint8_t>(kLineUnit - k)); // (no overflow)
+        uint32_t slope = (div_frac(g.dist[j], d1, static_cast<uint8_t>(k + 1)) + 1) >> 1;
+        // << (kLineUnit - k) (S_j <= 2^k: no overflow), 16 of it as a word move: a short line
+        // shifts by about 20, 20 turns of a 32-bit loop (shl_sat())
+        uint8_t up = static_cast<uint8_t>(kLineUnit - k);
+        if (up & 16) { // (up <= kLineUnit - 3 < 32)
+            slope <<= 16;
+            up &= 15;
+        }
+        g.slope[j] = slope << up;
     }
     return true;
 }

@@ -56,7 +56,8 @@ inline uint32_t profile_x2_decel(const Profile& p) {
 /// A at half-tick position x2 = 2 x (so that segment midpoints are exact):
 ///   A(x) = min(start(x), A_exit + s (d - x)), start(x) = A_entry +- s x clamped at A_cruise.
 /// The profile must be feasible: A_entry <= A_exit + s d (the planner guarantees it), and
-/// s d < 2^31 (the step generator picks s so).
+/// A + s d <= 2^31 for its A values (the step generator picks s so); x2 at most a little past
+/// 2 d (sums and shifts are not saturated).
 uint32_t profile_a(const Profile& p, uint32_t x2);
 
 /// The integer square root that follows A (seed §8.2), with C = R^2 kept so that a step of R

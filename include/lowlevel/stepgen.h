@@ -98,7 +98,11 @@ class StepGen {
 
     /// The planner raised the exit speed of the current move. Ignored once the end deceleration
     /// has begun (the seed's profile never accelerates at the end of a move).
-    void set_exit(uint32_t v_exit2);
+    /// (Called at every poll, usually with no change: that test inline, before the call and the
+    /// registers it saves.)
+    void set_exit(uint32_t v_exit2) {
+        if (v_exit2 != v_exit2_) raise_exit(v_exit2);
+    }
 
     /// Feed hold: from the next segment on, decelerate to a stop (possibly across moves).
     void hold();
@@ -144,6 +148,8 @@ class StepGen {
     }
 
   private:
+    /// set_exit() with a new exit.
+    void raise_exit(uint32_t v_exit2);
     bool begin_curve(const MoveSpec& spec);
     /// A line's part of begin() (out of line: begin()'s frame, under begin_curve(), stays
     /// small).
@@ -237,7 +243,11 @@ class StepGen {
         uint8_t lens_set[1u << (kAxes - 1)];       ///< the axis set each length is for
         uint32_t k[1u << (kAxes - 1)];             ///< K table, Q20 (see k())
         uint32_t cruise_period[1u << (kAxes - 1)]; ///< K * Delta_1 at cruise, cycles x 256
-        uint8_t cruise_seg;                        ///< segment length at cruise
+        uint8_t cruise_seg; ///< segment length at cruise (0: cruise_period not computed yet)
+        // kCruiseNum / feed for the feed of the last line (prepare_profile()), kept with the step
+        // lengths (0: none).
+        uint32_t feed;
+        Num per_feed;
     };
     struct CurveState {
         uint32_t ref_um;     ///< its length, µm (the profile's reference length)
@@ -253,6 +263,9 @@ class StepGen {
         LineState ln_;
         CurveState cv_;
     };
+    // The line state's caches (step lengths, kCruiseNum / feed) take room the curve state
+    // leaves: no static RAM of their own on the chip's 4 axes.
+    static_assert(kAxes != 4 || sizeof(LineState) <= sizeof(CurveState), "caches in spare room");
     int32_t start_[kAxes]; ///< position where the current (or last) move started, steps
     // Duration of each queued run in 1024-cycle units (saturated), by queue slot: keeps the
     // horizon without any help from the interrupt.
