@@ -24,6 +24,8 @@ namespace sim {
 namespace {
 
 constexpr const char* kMcu = "atmega328p";
+// The AVR data space that 16-bit addresses reach (simavr indexes avr->data with them).
+constexpr size_t kDataSpace = 0x10000;
 // While the receiver cannot take a byte (disabled, XOFF), the line is checked again this often:
 // 256 cycles = 16 us, a fifth of a frame, so a byte starts at most that late once it can.
 constexpr uint64_t kBlockedRetryCycles = 256;
@@ -96,6 +98,16 @@ Sim::Sim(const Options& opt) : opt_(opt) {
     const char* big_ram = getenv("LLSIM_BIG_RAM");
     if (big_ram && big_ram[0] == '1') avr_->ramend = 0x0FFF;
     avr_init(avr_);
+    // simavr 1.6 performs a store beyond RAMEND after reporting it and marking the core crashed
+    // (avr_core_watch_write; loads alike): a runaway firmware, such as GRBL 1.1h once its step
+    // interrupts nest, wrote past the RAMEND + 1 bytes avr_init() allocated and corrupted the
+    // host's heap. The buffer covers the whole 16-bit data space; the run still ends with the
+    // crash (selftest_stray_write).
+    const size_t ram = static_cast<size_t>(avr_->ramend) + 1;
+    uint8_t* data = static_cast<uint8_t*>(realloc(avr_->data, kDataSpace));
+    if (!data) throw SimError("llsim: out of memory");
+    memset(data + ram, 0, kDataSpace - ram);
+    avr_->data = data;
     avr_->log = static_cast<uint8_t>(opt_.log_level) & 0xF;
     avr_->frequency = kCpuHz;
     avr_load_firmware(avr_, &fw_);
