@@ -238,7 +238,7 @@ TEST_F(Protocol, SoftResetFlushesInputAndResetsTheParserNotTheSettings) {
 TEST_F(Protocol, SoftResetDuringMotionRaisesAlarm3) {
     d.send("G1 X50 F100\n");
     d.run_until_responses(1);
-    // The `ok` comes as soon as the move is planned; its steps start at the next poll.
+    // The `ok` comes with the planning of the move; its steps start at the next poll.
     EXPECT_EQ(d.run_for(kMs), "");
     if (ll::motion::state() == ll::motion::State::Idle) {
         GTEST_SKIP() << "this motion completes instantly (motion stub)";
@@ -251,9 +251,9 @@ TEST_F(Protocol, SoftResetDuringMotionRaisesAlarm3) {
 }
 
 TEST_F(Protocol, SoftResetBeforeTheFirstStepDropsTheMoveWithoutAlarm) {
-    // The `ok` comes once the move is planned, before its first step: a reset then loses no
-    // position (nothing moved), so it drops the move without ALARM:3, as GRBL does when its
-    // cycle has not started.
+    // The `ok` is queued just before the move is planned, in the same main-loop pass, and goes
+    // out before its first step: a reset then loses no position (nothing moved), so it drops
+    // the move without ALARM:3, as GRBL does when its cycle has not started.
     d.send("G1 X50 F100\n");
     d.run_until_responses(1);
     if (ll::motion::state() == ll::motion::State::Idle) {
