@@ -671,11 +671,11 @@ void StepGen::fill_curve(RunQueue& q) {
 #if LL_STATS
         ++stats.segments;
 #endif
-        // A curve segment costs a chord (a square root) on top of its samples: 8x the line
-        // segment duration keeps that cost to a fraction of the time the samples take (one
-        // sample when it needs idle waits).
-        seg_len_ =
-            next_segment(period_q8 >> 3, period_q8, 0xFFFFFFFFul); // no speed limit: <= 3 samples
+        // A curve segment costs a chord (a square root) on top of its samples: it takes the most
+        // samples it may, one when a sample needs idle waits. (This is what next_segment() gives
+        // for 8x the line segment duration without a speed limit: at least 4 up to a period of
+        // 0xFFFF cycles, else 1; without its call, 280 cycles less a segment.)
+        seg_len_ = period_q8 <= 0xFFFF00ul ? kMaxSamples : 1;
         if (cv_.w.done()) {
             seg_len_ = 1;
             finish_move();
