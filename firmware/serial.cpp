@@ -51,6 +51,8 @@ volatile uint8_t s_tx_active; // a "transmit complete" interrupt is still to com
 // about 25 cycles a byte more); the hardware's DOR0 (a byte lost before this one) waits in T. Named
 // __vector_* to keep its place in cmake/text_order.ld.
 extern "C" void __vector_rx_drain() __attribute__((naked, used, externally_visible));
+// Its full test is bit 7 of tail - head (128 queued): the ring must hold exactly 128 bytes.
+static_assert(ll::kRxSize == 128, "__vector_rx_drain tests a full ring as tail - head >= 128");
 void __vector_rx_drain() {
     asm volatile(
         "push r24\n\t"
@@ -63,7 +65,7 @@ void __vector_rx_drain() {
         "bst  r24, %[dor0]\n\t"
         "lds  r24, %[udr0]\n\t"
         // The four real-time commands (a bit of rt::g_pending each) and GRBL's extended bytes
-        // (0x84-0x87, 0x90-0x9D, 0xA0-0xA1), consumed; split at '?' so that a digit takes 7
+        // (0x84-0x87, 0x90-0x9D, 0xA0-0xA1), consumed; split at '?' so that a digit takes 8
         // cycles of tests and a capital 9.
         "cpi  r24, '?'\n\t"
         "breq 7f\n\t"

@@ -360,8 +360,9 @@ uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift) {
 #endif
 
 uint32_t shl_sat(uint32_t x, uint8_t k) {
-    // Whole bytes while the top byte is free (the speed profile's k = 8 of short moves: 105 -> 33
-    // cycles a call), then a bit at a time; a test against 2^32 >> k would be a second variable
+    // Whole bytes while the top byte is free (a feed hold's deceleration in delta_at() and
+    // profile_x2_decel() shift by s / 2 or s, 8 or 9 for short moves: 105 -> 33 cycles a call),
+    // then a bit at a time; a test against 2^32 >> k would be a second variable
     // shift (a loop on the ATmega328P). Zero stays zero (no bit ever reaches the top: no test
     // for it); anything else saturates within 32 turns.
 #if defined(__AVR__)

@@ -293,9 +293,10 @@ void StepGen::set_a_exit() {
 
 void StepGen::raise_exit(uint32_t v_exit2) {
     if (!active_ || holding_) return;
-    // End deceleration already begun: the profile in force is on its end line where the last
-    // segment ended, A(x) = A_exit + s (d - x) <= start(x) (profile_a(), which is that minimum;
-    // the same test as x >= profile_x2_decel(), in A, without its variable shifts).
+    // End deceleration already begun (never accelerate at the end of a move, seed §4.1): the
+    // profile in force is on its end line where the last segment ended, A(x) = A_exit + s (d - x)
+    // <= start(x) (profile_a(), which is that minimum; the same test as x >= profile_x2_decel(), in
+    // A, without its variable shifts).
     const uint32_t x2 = x2_now();
     const uint32_t to_go2 = 2 * prof_.d - x2;
     if (to_go2 > 2 * prof_.d) return; // (a curve's samples may run past its length)

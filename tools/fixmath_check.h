@@ -199,6 +199,13 @@ inline uint32_t fixmath_edges() {
             h.add(ll::Num(y).div(x));
         }
     }
+    // shl_sat around its byte steps (the chip shifts whole bytes while the top byte is free).
+    const uint32_t xs[8] = {0,         1,          0xFF,         0xFFFFFF,
+                            0x1000000, 0x7FFFFFFF, 0x80000000ul, 0xFFFFFFFFul};
+    const uint8_t ks[15] = {0, 1, 7, 8, 9, 15, 16, 24, 31, 32, 33, 40, 63, 64, 255};
+    for (uint8_t i = 0; i < 8; ++i) {
+        for (uint8_t j = 0; j < 15; ++j) h.add(shl_sat(xs[i], ks[j]));
+    }
     // sum_squares at the bounds of the chip's short path (at most 4 values, each below 2^15):
     // every value 0x7FFF, one of them 0x8000, five values, and masks with bits beyond n.
     const uint32_t vs[5] = {0x7FFF, 0x7FFF, 0x7FFF, 0x7FFF, 0x7FFF};

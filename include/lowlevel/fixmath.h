@@ -34,7 +34,8 @@ uint32_t shr64_sat(uint32_t hi, uint32_t lo, uint8_t shift);
 uint32_t mul_shr(uint32_t a, uint32_t b, uint8_t shift);
 
 /// floor(n / d) for a 16-bit divisor d != 0 (the step generator's D / R): 32 turns of a 17-bit
-/// remainder on the ATmega328P instead of the library's 32-bit one.
+/// remainder on the ATmega328P instead of the library's 32-bit one (24 when n's top byte is
+/// below d: the first 8 quotient bits are then 0, and the remainder starts as that byte).
 uint32_t div32_16(uint32_t n, uint16_t d);
 
 /// min(x << k, 2^32 - 1).

@@ -81,7 +81,7 @@ inline bool line_setup(LineGeometry& g, const int32_t delta[kAxes]) {
         // 2^(kLineUnit - k) (the same value, aligned: line_advance shifts by a constant).
         uint32_t slope = (div_frac(g.dist[j], d1, static_cast<uint8_t>(k + 1)) + 1) >> 1;
         // << (kLineUnit - k) (S_j <= 2^k: no overflow), 16 of it as a word move: a short line
-        // shifts by about 20, 20 turns of a 32-bit loop (shl_sat())
+        // shifts by about 20, 20 turns of a 32-bit loop
         uint8_t up = static_cast<uint8_t>(kLineUnit - k);
         if (up & 16) { // (up <= kLineUnit - 3 < 32)
             slope <<= 16;
@@ -113,6 +113,8 @@ inline void line_start(const LineGeometry& g, LineCursor& c) {
 
 /// Moves the macro position `len` reference ticks further (1 <= len <= kMaxSegmentTicks and
 /// len <= dist[0] - x1) and writes the increment of each sorted position into e[0..m).
+/// Precondition: g.m >= 1 (line_setup() refuses a line that moves no axis; the loop over the
+/// minor axes counts down from m).
 /// e[0] == len and e[j] <= len.
 void line_advance(const LineGeometry& g, LineCursor& c, uint8_t len, uint8_t e[kAxes]);
 

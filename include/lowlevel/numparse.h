@@ -34,7 +34,8 @@ struct Decimal {
 
 /// Reads `[+|-]digits[.digits]` (at least one digit; GRBL's read_float without its float) at
 /// `p`. Returns the character after it, or nullptr when no digit is present or the integer
-/// part has more than 9 digits.
+/// part has more than 9 digits; `out` is then unspecified (the chip's assembly may have written
+/// part of it, the host's C leaves it as it was).
 const char* parse(const char* p, Decimal& out);
 /// The same with a position in `s`, advanced past the number (unchanged on failure).
 inline bool parse(const char* s, uint8_t& pos, Decimal& out) {

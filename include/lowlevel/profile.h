@@ -41,7 +41,8 @@ struct Profile {
 /// where the start and end lines meet, the move decelerates from max(x_d, x*) when it
 /// accelerates at its start (x* > x_d exactly when the cruise speed is out of reach, and the
 /// peak is then A(x*) = (A_entry + A_exit + s d) / 2), and from x_d otherwise.
-/// (Inline: its one caller on the chip, StepGen::set_a_exit(), takes it without a call.)
+/// (The tests' reference: StepGen::raise_exit() makes the same test in A values, without the
+/// variable shifts, test_stepgen's RaisedExitIsTakenUntilTheEndDecelerationBegins.)
 inline uint32_t profile_x2_decel(const Profile& p) {
     const uint8_t half = static_cast<uint8_t>(p.log_s - 1); // s / 2 = 2^half
     uint32_t drop = (p.a_cruise - p.a_exit) >> half;        // half ticks to decelerate from cruise
@@ -55,9 +56,10 @@ inline uint32_t profile_x2_decel(const Profile& p) {
 
 /// A at half-tick position x2 = 2 x (so that segment midpoints are exact):
 ///   A(x) = min(start(x), A_exit + s (d - x)), start(x) = A_entry +- s x clamped at A_cruise.
-/// The profile must be feasible: A_entry <= A_exit + s d (the planner guarantees it), and
-/// A + s d <= 2^31 for its A values (the step generator picks s so); x2 at most a little past
-/// 2 d (sums and shifts are not saturated).
+/// The profile must be feasible: A_entry <= A_exit + s d (the planner guarantees it). Sums and
+/// shifts are not saturated: the A values are at most kMaxA = 2^31 (StepGen::a_of() clamps
+/// them), and s d <= 2^31 at the scale the step generator picks (at its smallest, s = 2, s d <
+/// 2^24 for d <= kMaxLineTicks), so every sum stays below 2^32; x2 at most a little past 2 d.
 uint32_t profile_a(const Profile& p, uint32_t x2);
 
 /// The integer square root that follows A (seed §8.2), with C = R^2 kept so that a step of R

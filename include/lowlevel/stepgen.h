@@ -35,6 +35,10 @@ constexpr uint16_t kMinSegmentCycles = 6144;
 /// of about 3,000 cycles each, and the circle of such lines (docs/benchmarks.md) ran at
 /// 1.74 x its ideal time, the CPU being the limit.
 constexpr uint16_t kSegmentCycles = 32768;
+// fill_curve() gives a curve segment its most samples (3) whenever a sample lasts at most 0xFFFF
+// cycles, without next_segment(): what next_segment() gave for 8 x the line duration, 4 samples
+// or more, as long as kSegmentCycles x 256 exceeds a quarter of 0xFFFF00.
+static_assert(kSegmentCycles >= 16384, "curve segments of 3 samples up to 0xFFFF cycles each");
 /// How far ahead of the step interrupt the generator commits motion, CPU cycles (4 ms). Motion
 /// not yet produced can still be replanned (a later move raising this one's exit speed, a feed
 /// hold), so the generator stays this close behind the interrupt; the main loop must come back
@@ -97,7 +101,7 @@ class StepGen {
     void clear_queue_time();
 
     /// The planner raised the exit speed of the current move. Ignored once the end deceleration
-    /// has begun (the seed's profile never accelerates at the end of a move).
+    /// has begun (the seed's profile never accelerates at the end of a move, seed §4.1).
     /// (Called at every poll, usually with no change: that test inline, before the call and the
     /// registers it saves.)
     void set_exit(uint32_t v_exit2) {

@@ -205,3 +205,44 @@ TEST(FirmwareSmoke, BadLinesAreRejectedAndCauseNoStep) {
     EXPECT_EQ(ps.pulses[1] + ps.pulses[2] + ps.pulses[3], 0u);
     expect_stack_above_static_ram(b.sim);
 }
+
+TEST(FirmwareSmoke, ReceiveInterruptConsumesExtendedBytesAndLosesNothingBeforeTheRingIsFull) {
+    // The receive interrupt's tail is assembly (firmware/serial.cpp) with the tests of
+    // rt::filter(): GRBL 1.1's extended real-time bytes are consumed inside a line, their
+    // neighbours reach the line (a non-ASCII byte: error:20), and a full 128-byte ring loses the
+    // byte after it, with the overflow flag set.
+    REQUIRE_FIRMWARE();
+    Booted b;
+    ASSERT_TRUE(b.grbl.wait_banner(ms(500)));
+    ASSERT_TRUE(b.grbl.send_line("$100=80", kLine).ok);
+    const std::string consumed = "\x84\x85\x86\x87\x90\x97\x9D\xA0\xA1";
+    ASSERT_TRUE(b.grbl.send_line("G1" + consumed + "X0.1F600", kLine).ok);
+    for (char c : std::string("\x83\x88\x8F\x9E\x9F\xA2")) {
+        const Reply r = b.grbl.send_line(std::string("G1X0.2") + c + "F600", kLine);
+        EXPECT_FALSE(r.ok) << static_cast<int>(static_cast<uint8_t>(c));
+        EXPECT_EQ(r.error, 20) << static_cast<int>(static_cast<uint8_t>(c));
+    }
+    ASSERT_TRUE(wait_idle(b, ms(1000)));
+    // Fill the planner with slow moves: the next line waits for room, and while it waits the main
+    // loop reads no byte (docs/protocol.md), so the ring fills from the interrupt alone.
+    for (unsigned i = 1; i <= ll::kPlannerSize + 1; ++i)
+        b.sim.send("G1X" + std::to_string(i) + "F60\n");
+    b.sim.run_for(ms(200));
+    const uint16_t head = static_cast<uint16_t>(b.sim.symbol("_ZN2ll12_GLOBAL__N_19s_rx_headE"));
+    const uint16_t tail = static_cast<uint16_t>(b.sim.symbol("_ZN2ll12_GLOBAL__N_19s_rx_tailE"));
+    const uint16_t lost =
+        static_cast<uint16_t>(b.sim.symbol("_ZN2ll12_GLOBAL__N_113s_rx_overflowE"));
+    const uint8_t queued = static_cast<uint8_t>(b.sim.peek(tail) - b.sim.peek(head));
+    ASSERT_LT(queued, 100u) << "the main loop should be waiting with few bytes queued";
+    EXPECT_EQ(b.sim.peek(lost), 0u);
+    // Exactly as many bytes as the ring has room for: none lost.
+    b.sim.send(std::string(128u - queued, 'X'));
+    b.sim.run_for(ms(20));
+    EXPECT_EQ(static_cast<uint8_t>(b.sim.peek(tail) - b.sim.peek(head)), 128u);
+    EXPECT_EQ(b.sim.peek(lost), 0u);
+    // One more: lost, and flagged.
+    b.sim.send("X");
+    b.sim.run_for(ms(1));
+    EXPECT_EQ(static_cast<uint8_t>(b.sim.peek(tail) - b.sim.peek(head)), 128u);
+    EXPECT_EQ(b.sim.peek(lost), 1u);
+}
