@@ -386,7 +386,8 @@ inline void fd_step(int64_t v[4]) {
 
 // acc += x / 2^s in Q40 for x in Q8 (s <= 36): exact for s <= 32, floored beyond.
 #if defined(__AVR__)
-// In assembly: the addend in two words (x, 0) shifted together, then added byte by byte. avr-gcc
+// In assembly: the addend in two words (x, 0) shifted together (whole bytes by moves, the rest
+// bit by bit: a piece's shifts reach 3 m bits), then added byte by byte. avr-gcc
 // would call the 64-bit shift and sum routines of its library, which nothing else in the image
 // needs.
 extern "C" void ll_curve_add_q40(int64_t& acc, int32_t x, uint8_t s);
@@ -400,7 +401,21 @@ asm(".section .text.ll_curve_add_q40,\"ax\",@progbits\n"
     "clr  r18\n"
     "clr  r19\n"
     "movw r20, r18\n"
-    "tst  r30\n"
+    "0:\n" // whole bytes by moves first
+    "subi r30, 8\n"
+    "brcs 3f\n"
+    "mov  r18, r19\n"
+    "mov  r19, r20\n"
+    "mov  r20, r21\n"
+    "mov  r21, r22\n"
+    "mov  r22, r23\n"
+    "mov  r23, r24\n"
+    "mov  r24, r25\n"
+    "lsl  r25\n"
+    "sbc  r25, r25\n"
+    "rjmp 0b\n"
+    "3:\n"
+    "subi r30, -8\n" // the bits left, s mod 8
     "breq 2f\n"
     "1:\n"
     "asr  r25\n"
@@ -519,7 +534,9 @@ __attribute__((always_inline)) inline void CurveWalker::start_piece(Piece& g) {
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
     for (uint8_t a = 0; a < 3; ++a) {
         // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
-        memcpy(reinterpret_cast<uint8_t*>(fd_[a]) + 4, &prev_q8_[a], 4);
+        // (Plus half a tick: next() rounds by taking the ticks' bits alone.)
+        const int32_t f = prev_q8_[a] + 128;
+        memcpy(reinterpret_cast<uint8_t*>(fd_[a]) + 4, &f, 4);
         const int32_t d = g.v[kP3][a] - prev_q8_[a];
         prev_q8_[a] = g.v[kP3][a];
         const int32_t c1 = g.v[kArm0][a];
@@ -698,11 +715,12 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
         if (walking) {
             int64_t* v = fd_[a];
             fd_step(v);
-            // round(f / 2^40) from the high word: floor((hi + 2^7) / 2^8). The word is read
-            // from memory: avr-gcc would shift the 64 bits through a library loop.
+            // round(f / 2^40) from the high word of f + 2^39 (start_piece): floor(hi / 2^8).
+            // The word is read from memory: avr-gcc would shift the 64 bits through a library
+            // loop.
             int32_t hi;
             memcpy(&hi, reinterpret_cast<const uint8_t*>(v) + 4, 4);
-            p = (hi + 128) >> 8;
+            p = hi >> 8;
         }
         if (p != pos[a]) {
             bits = static_cast<uint8_t>(bits | bit);
@@ -717,13 +735,11 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
     return true;
 }
 
-uint16_t CurveWalker::peek(int32_t d[3]) {
-    if (left_ == 0 && kind_ != 0) next_piece(); // (a piece has at least one sample)
+void CurveWalker::chord(int32_t d[3]) const {
     // d1 / 2^24 (below 2^17): bits 24 to 55 of the little-endian word.
     for (uint8_t a = 0; a < 3; ++a) {
         memcpy(&d[a], reinterpret_cast<const uint8_t*>(&fd_[a][1]) + 3, 4);
     }
-    return left_;
 }
 
 namespace {

@@ -597,15 +597,26 @@ void StepGen::fill_curve(RunQueue& q) {
         if (horizon_full(q)) break;
         // The chord of the next sample sets the time of every sample of the segment (the
         // segment never crosses into the next piece, whose samples may be twice as long).
-        int32_t d[3];
-        uint16_t left = cv_.w.peek(d);
+        const uint16_t left = cv_.w.peek();
+        // The segment's length depends on the speed only, never on how full the queue is (the
+        // chip and the host model must cut the same segments): wait for room for all of it.
+        // At most 3 samples (6 runs in the worst case), so that the queue is still half full
+        // when there is room for a whole segment.
+        constexpr uint8_t kMaxSamples = 3;
+        uint8_t n = seg_len_ < kMaxSamples ? seg_len_ : kMaxSamples;
+        if (left != 0 && left < n) n = static_cast<uint8_t>(left);
+        // (Tested before the chord is read or computed: a segment that waits costs no more.)
+        if (q.free_slots() < 2 * n + 2) break;
         // The chord changes slowly along a piece: computed again (a square root) when a piece
         // starts and every 8 samples, not for every segment (chord_left: the samples left in
-        // the piece when it was computed, 0: none yet).
+        // the piece when it was computed, 0: none yet). One test covers the three cases: the
+        // samples since then wrap around to 2^16 - left or more (a piece has at most 4096) when
+        // there is no chord yet (left >= 1 then) or a new piece has started (left > chord_left).
         uint32_t chord_q8 = cv_.chord_q8;
-        const uint16_t since = static_cast<uint16_t>(cv_.chord_left - left);
-        const bool fresh = cv_.chord_left == 0 || left > cv_.chord_left || since >= 8;
+        const bool fresh = static_cast<uint16_t>(cv_.chord_left - left) >= 8;
         if (fresh) {
+            int32_t d[3];
+            cv_.w.chord(d);
             Num sum{};
             uint8_t chord = cv_.chord;
             for (uint8_t k = 0; k < 3; ++k, chord >>= 1) {
@@ -619,14 +630,6 @@ void StepGen::fill_curve(RunQueue& q) {
             chord_q8 = sum.sqrt().mulc(0xFA000000ul, -30).u32();
             if (chord_q8 == 0) chord_q8 = 1;
         }
-        // The segment's length depends on the speed only, never on how full the queue is (the
-        // chip and the host model must cut the same segments): wait for room for all of it.
-        // At most 3 samples (6 runs in the worst case), so that the queue is still half full
-        // when there is room for a whole segment.
-        constexpr uint8_t kMaxSamples = 3;
-        uint8_t n = seg_len_ < kMaxSamples ? seg_len_ : kMaxSamples;
-        if (left != 0 && left < n) n = static_cast<uint8_t>(left);
-        if (q.free_slots() < 2 * n + 2) break;
         uint32_t mid = cv_.x_q8 + chord_q8 * n / 2;
         const uint32_t delta = delta_at(2 * (mid >> 8));
         if (stopped_) break;
@@ -660,8 +663,8 @@ void StepGen::fill_curve(RunQueue& q) {
                 run_neg = moved ? neg : run_neg;
             }
             ++run_count;
+            cv_.x_q8 += chord_q8; // (a sum a sample: no product)
         }
-        cv_.x_q8 += chord_q8 * i;
         // Kept only for a segment actually made: the chip and the host model stop at different
         // times for room, and must still use the same chord for the same samples.
         if (fresh) {

@@ -103,7 +103,18 @@ class CurveWalker {
     /// that sample's displacement, ticks x 2^16 per axis: its chord, from which the step
     /// generator times it. Returns the samples left in the piece (0: only the final step to
     /// the exact end remains, or nothing at all).
-    uint16_t peek(int32_t d[3]);
+    uint16_t peek(int32_t d[3]) {
+        const uint16_t left = peek();
+        chord(d);
+        return left;
+    }
+    /// peek() in two parts, for a step generator that needs the displacement now and then only:
+    /// the samples left (making the next sample's piece current), and the displacement.
+    uint16_t peek() {
+        if (left_ == 0 && kind_ != 0) next_piece(); // (a piece has at least one sample)
+        return left_;
+    }
+    void chord(int32_t d[3]) const;
     bool done() const { return kind_ == 0; }
 
     int32_t pos[3]; ///< current position, ticks (u, v, w)
