@@ -742,6 +742,26 @@ void CurveWalker::chord(int32_t d[3]) const {
     }
 }
 
+// (Here, not in the step generator: the displacement is read in place, and the Num values are in
+// this frame, not in fill_curve()'s while the walker steps below it.)
+uint32_t CurveWalker::chord_q8(uint8_t timed, const uint8_t machine[3], const Num inv2[]) const {
+    Num sum{};
+    for (uint8_t k = 0; k < 3; ++k, timed = static_cast<uint8_t>(timed >> 1)) {
+        if (!(timed & 1)) continue;
+        // d1 / 2^24, ticks x 2^16 (as chord() gives it)
+        int32_t d;
+        memcpy(&d, reinterpret_cast<const uint8_t*>(&fd_[k][1]) + 3, 4);
+        Num v(abs32(d));
+        v.mul(v).mul(inv2[machine[k]]);
+        sum.add(v);
+    }
+    // mm over 2^16 -> µm x 256: x 256000 / 2^16 = 0xFA000000 x 2^-30 (mul() would take 256000
+    // as 0xFA000000 x 2^-14, then the shift)
+    uint32_t len = sum.sqrt().mulc(0xFA000000ul, -30).u32();
+    if (len == 0) len = 1;
+    return len;
+}
+
 namespace {
 
 // (1 - sqrt(3/5)) / 2, Q30: the outer Gauss-Legendre nodes of a panel [0, 1].
@@ -1009,7 +1029,8 @@ bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& o
     int8_t scale;
     uint32_t span = kOneQ29;
     uint8_t turns = 0;
-    uint32_t circle_r = 0; // a circle's radius (0: not a circle)
+    bool circle = false;
+    Num len{};
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
     k.rise.set(abs32(dw_um));
     if (cp.kind == kCurveArc) {
@@ -1020,13 +1041,29 @@ bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& o
         if (span == 0) return false; // a null radius
         turns = cp.turns;
         // w rises linearly with the angle: dw / |sweep| per radian.
-        k.rise.div(Num(kTurnQ29, -29).mul(turns).add(Num(span, -29)));
+        Num ld[2]; // |sweep| (radians), and |dw| for a circle's length below
+        ld[1] = k.rise;
+        ld[0].set(kTurnQ29, -29).mul(turns).add(Num(span, -29));
+        k.rise.div(ld[0]);
         memcpy(k.e.r, r, sizeof(k.e.r));
         scale = normalise(k.e.r, 2);
         const uint32_t hi = larger(r);
         const uint32_t lo = r[0] ^ r[1] ^ hi;
         out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
-        if (lo == hi) circle_r = lo;
+        if (lo == hi) {
+            // A circle in closed form: r |sweep|, and a circular helix sqrt(plane^2 + dw^2).
+            // (The quadrature gives the same to 1e-7, its speed being constant, but at ~20 times
+            // the cycles: 0.7 M for a whole circle instead of 37 k, too slow for streams of short
+            // arcs.)
+            circle = true;
+            ld[0].mul(lo);
+            if (w_regulated) {
+                root_sum_squares(ld, 2, len);
+            } else {
+                len = ld[0];
+            }
+            len.shift(8); // um x 256
+        }
     } else {
         // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
@@ -1054,21 +1091,7 @@ bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& o
     k.rise.shift(scale);
     k.w_counts = w_regulated;
     tangent(k, out.start_dir);
-    Num len{};
-    if (circle_r != 0) {
-        // A circle in closed form: r |sweep|, and a circular helix sqrt(plane^2 + dw^2). (The
-        // quadrature gives the same to 1e-7, its speed being constant, but at ~20 times the
-        // cycles: 0.7 M for a whole circle instead of 37 k, too slow for streams of short arcs.)
-        Num ld[2];
-        ld[0].set(kTurnQ29, -29).mul(turns).add(Num(span, -29)).mul(circle_r);
-        ld[1].set(abs32(dw_um));
-        if (w_regulated) {
-            root_sum_squares(ld, 2, len);
-        } else {
-            len = ld[0];
-        }
-        len.shift(8); // um x 256
-    } else {
+    if (!circle) {
         track_length(k, span, len);
         // An ellipse's extra turns: a full turn from wherever.
         if (turns) {

@@ -614,22 +614,7 @@ void StepGen::fill_curve(RunQueue& q) {
         // there is no chord yet (left >= 1 then) or a new piece has started (left > chord_left).
         uint32_t chord_q8 = cv_.chord_q8;
         const bool fresh = static_cast<uint16_t>(cv_.chord_left - left) >= 8;
-        if (fresh) {
-            int32_t d[3];
-            cv_.w.chord(d);
-            Num sum{};
-            uint8_t chord = cv_.chord;
-            for (uint8_t k = 0; k < 3; ++k, chord >>= 1) {
-                if (!(chord & 1)) continue;
-                Num v(abs32(d[k]));
-                v.mul(v).mul(lengths_->inv2[cv_.axes[k]]);
-                sum.add(v);
-            }
-            // mm over 2^16 -> µm x 256: x 256000 / 2^16 = 0xFA000000 x 2^-30 (mul() would take
-            // 256000 as 0xFA000000 x 2^-14, then the shift)
-            chord_q8 = sum.sqrt().mulc(0xFA000000ul, -30).u32();
-            if (chord_q8 == 0) chord_q8 = 1;
-        }
+        if (fresh) chord_q8 = cv_.w.chord_q8(cv_.chord, cv_.axes, lengths_->inv2);
         uint32_t mid = cv_.x_q8 + chord_q8 * n / 2;
         const uint32_t delta = delta_at(2 * (mid >> 8));
         if (stopped_) break;
@@ -641,11 +626,19 @@ void StepGen::fill_curve(RunQueue& q) {
         // rotation of the three bits by plane = 2 - axes[2] to the right, once per run.
         const uint8_t plane = static_cast<uint8_t>(2 - cv_.axes[2]);
         uint8_t run_moved = 0, run_neg = 0, run_count = 0;
-        // One emit() for both ends of a run: a sample that differs, or none left.
-        uint8_t i = 0;
-        for (;; ++i) {
-            uint8_t moved = 0, neg = 0;
-            const bool more = i < n && cv_.w.next(moved, neg);
+        // The runs of a segment share its period: rounded and clamped here once, and pushed as
+        // emit() would when it fits 16 bits (else emit() makes each run's idle waits). emit()
+        // cost 290 cycles a run, push() costs 74.
+        static_assert(0xFFFF00ul < kMaxPeriodCycles << 8, "a whole period is never capped");
+        static_assert((kMaxSamples * 0xFFFFul) >> 10 <= 255, "a run's time never saturates");
+        const bool whole = period_q8 <= 0xFFFF00ul;
+        uint16_t p16 = static_cast<uint16_t>((period_q8 + 128) >> 8);
+        const bool clamped = p16 < min_period_;
+        if (clamped) p16 = min_period_;
+        // One push for both ends of a run: a sample that differs, or none left.
+        for (;; --n) {
+            uint8_t moved, neg; // (read only when next() has set them)
+            const bool more = n != 0 && cv_.w.next(moved, neg);
             if (run_count != 0 && (!more || moved != run_moved || (moved && neg != run_neg))) {
                 uint8_t steps = static_cast<uint8_t>(run_moved * 9u);
                 uint8_t dirs = static_cast<uint8_t>(run_neg * 9u);
@@ -653,14 +646,25 @@ void StepGen::fill_curve(RunQueue& q) {
                     steps = static_cast<uint8_t>(steps >> 1);
                     dirs = static_cast<uint8_t>(dirs >> 1);
                 }
-                emit(q, static_cast<uint8_t>(steps & 7), static_cast<uint8_t>(dirs & 7), run_count,
-                     period_q8);
+                steps = static_cast<uint8_t>(steps & 7);
+                dirs = static_cast<uint8_t>(dirs & 7);
+                if (whole) {
+                    // (as emit() counts a run's time)
+                    const uint8_t units = static_cast<uint8_t>(
+                        static_cast<uint16_t>((static_cast<uint32_t>(p16) * run_count) >> 8) >> 2);
+                    push(q, steps, dirs, run_count, p16, units);
+#if LL_STATS
+                    if (clamped) ++stats.clamped;
+#endif
+                } else {
+                    emit(q, steps, dirs, run_count, period_q8);
+                }
                 run_count = 0;
             }
             if (!more) break;
             if (run_count == 0) {
                 run_moved = moved;
-                run_neg = moved ? neg : run_neg;
+                if (moved) run_neg = neg;
             }
             ++run_count;
             cv_.x_q8 += chord_q8; // (a sum a sample: no product)
@@ -678,7 +682,7 @@ void StepGen::fill_curve(RunQueue& q) {
         // samples it may, one when a sample needs idle waits. (This is what next_segment() gives
         // for 8x the line segment duration without a speed limit: at least 4 up to a period of
         // 0xFFFF cycles, else 1; without its call, 280 cycles less a segment.)
-        seg_len_ = period_q8 <= 0xFFFF00ul ? kMaxSamples : 1;
+        seg_len_ = whole ? kMaxSamples : 1;
         if (cv_.w.done()) {
             seg_len_ = 1;
             finish_move();

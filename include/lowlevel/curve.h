@@ -22,6 +22,8 @@
 
 namespace ll {
 
+struct Num;
+
 enum : uint8_t { kCurveArc = 1, kCurveBezier = 2 };
 
 /// The axes of a plane: u and v span it, w is its normal (the helix axis). G17: (X, Y, Z),
@@ -115,6 +117,10 @@ class CurveWalker {
         return left_;
     }
     void chord(int32_t d[3]) const;
+    /// The length of the next sample (its chord) along the axes whose bit (u = 1, v = 2,
+    /// w = 4) is set in `timed`, µm x 256, at least 1: sqrt(sum of d^2 / T^2) for the machine
+    /// axes `machine[k]` of step lengths T (`inv2`: 1/T^2, mm^2 per step^2, per machine axis).
+    uint32_t chord_q8(uint8_t timed, const uint8_t machine[3], const Num inv2[]) const;
     bool done() const { return kind_ == 0; }
 
     int32_t pos[3]; ///< current position, ticks (u, v, w)
