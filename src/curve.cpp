@@ -532,7 +532,10 @@ __attribute__((always_inline)) inline void CurveWalker::start_piece(Piece& g) {
     // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0 (in place of arm0, p3 and arm3).
     memset(fd_, 0, sizeof(fd_));
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
-    for (uint8_t a = 0; a < 3; ++a) {
+    // (w's coefficients are zero on a curve of two axes, whose w never moves: its differences
+    // stay the zeros above, and next() never reads them.)
+    const uint8_t axes = axes_;
+    for (uint8_t a = 0; a < axes; ++a) {
         // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
         // (Plus half a tick: next() rounds by taking the ticks' bits alone.)
         const int32_t f = prev_q8_[a] + 128;
@@ -556,7 +559,7 @@ __attribute__((always_inline)) inline void CurveWalker::start_piece(Piece& g) {
         samples = static_cast<uint16_t>(samples << 1);
     }
     left_ = samples;
-    for (uint8_t a = 0; a < 3; ++a) {
+    for (uint8_t a = 0; a < axes; ++a) {
         int64_t* v = fd_[a];
         // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
         // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3, term by term (c_pw / N^pw into the differences 1 to pw).

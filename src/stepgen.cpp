@@ -612,9 +612,15 @@ void StepGen::fill_curve(RunQueue& q) {
         // the piece when it was computed, 0: none yet). One test covers the three cases: the
         // samples since then wrap around to 2^16 - left or more (a piece has at most 4096) when
         // there is no chord yet (left >= 1 then) or a new piece has started (left > chord_left).
-        uint32_t chord_q8 = cv_.chord_q8;
-        const bool fresh = static_cast<uint16_t>(cv_.chord_left - left) >= 8;
-        if (fresh) chord_q8 = cv_.w.chord_q8(cv_.chord, cv_.axes, lengths_->inv2);
+        // Kept at once: the room is there, so the segment is made unless the speed reaches zero
+        // first (a hold), and then the same samples are still next and have the same chord. (The
+        // chip and the host model stop at different times for room, and must still use the same
+        // chord for the same samples.)
+        if (static_cast<uint16_t>(cv_.chord_left - left) >= 8) {
+            cv_.chord_q8 = cv_.w.chord_q8(cv_.chord, cv_.axes, lengths_->inv2);
+            cv_.chord_left = left;
+        }
+        const uint32_t chord_q8 = cv_.chord_q8;
         uint32_t mid = cv_.x_q8 + chord_q8 * n / 2;
         const uint32_t delta = delta_at(2 * (mid >> 8));
         if (stopped_) break;
@@ -668,12 +674,6 @@ void StepGen::fill_curve(RunQueue& q) {
             }
             ++run_count;
             cv_.x_q8 += chord_q8; // (a sum a sample: no product)
-        }
-        // Kept only for a segment actually made: the chip and the host model stop at different
-        // times for room, and must still use the same chord for the same samples.
-        if (fresh) {
-            cv_.chord_q8 = chord_q8;
-            cv_.chord_left = left;
         }
 #if LL_STATS
         ++stats.segments;
