@@ -124,6 +124,9 @@ class CurveWalker {
     bool done() const { return kind_ == 0; }
 
     int32_t pos[3]; ///< current position, ticks (u, v, w)
+    // The walker's own (public only to follow pos in memory, as Ends' start and end do: begin()
+    // copies both in one piece).
+    int32_t end_[3]; ///< final position, ticks
 
   private:
     void begin(const Ends& e, uint16_t pieces, uint8_t kind);
@@ -149,7 +152,6 @@ class CurveWalker {
     uint8_t log_pieces_;    ///< Bezier: 2^j pieces
     int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
     int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
-    int32_t end_[3];        ///< final position, ticks
     // An arc or a Bezier, never both.
     struct ArcState {
         int32_t centre[2];
