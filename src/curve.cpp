@@ -98,8 +98,8 @@ asm(".section .text.ll_curve_mul_shift,\"ax\",@progbits\n"
     "rjmp 8b\n"
     "ret\n"
     "4:\n"
-    "cpi  r26, 8\n"
-    "brlo 5f\n"
+    "subi r26, 8\n"
+    "brcs 5f\n"
     "mov  r18, r19\n"
     "mov  r19, r20\n"
     "mov  r20, r21\n"
@@ -107,10 +107,9 @@ asm(".section .text.ll_curve_mul_shift,\"ax\",@progbits\n"
     "mov  r22, r23\n"
     "mov  r23, r24\n"
     "mov  r24, r25\n"
-    "subi r26, 8\n"
     "rjmp 4b\n"
     "5:\n"
-    "tst  r26\n"
+    "subi r26, -8\n" // the bits left, s mod 8
     "breq 7f\n"
     "6:\n"
     "lsr  r25\n"
@@ -697,11 +696,12 @@ bool CurveWalker::next_piece() {
     int32_t *p3 = g.v[kP3], *arm0 = g.v[kArm0], *arm3 = g.v[kArm3];
     // Helix: w moves linearly (arms of a third of its move), the last piece landing exactly on
     // the end.
-    int32_t w3 = dw_q8_;
-    if (!last) {
+    const int32_t dw = dw_q8_;
+    int32_t w3 = dw;
+    if (!last && dw != 0) { // (w moves: a helix)
         w3 = static_cast<int32_t>(
-            Num(abs32(dw_q8_)).mul(static_cast<uint32_t>(index) + 1).div(piece_count_).u32());
-        if (dw_q8_ < 0) w3 = -w3;
+            Num(abs32(dw)).mul(static_cast<uint32_t>(index) + 1).div(piece_count_).u32());
+        if (dw < 0) w3 = -w3;
     }
     p3[2] = w3 + w0_q8_;
     arm0[2] = arm3[2] = p3[2] - prev_q8_[2];
