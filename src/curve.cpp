@@ -32,8 +32,10 @@ constexpr uint32_t kMaxPieceTicks = 2000;
 // of fixmath's multiplier (__ll_mul32, its own register convention) made signed (a negative
 // factor counts as the unsigned one less 2^32: the other factor is taken off the high word), then
 // the bits s to s + 31 of the 64-bit word, whole bytes by moves first; bits shifted in at the top
-// never reach the low word for s <= 32. In assembly: avr-gcc would call its 64-bit product and
-// shift routines, which nothing else in the image needs, and it saves more registers.
+// never reach the low word for s <= 32. For s = 30 (mul_q30, 16 products a piece of an arc), bytes
+// 3 to 7 shifted left twice: 95 cycles less than three moves and six shifts right. In assembly:
+// avr-gcc would call its 64-bit product and shift routines, which nothing else in the image needs,
+// and it saves more registers.
 extern "C" int32_t ll_curve_mul_shift(int32_t a, int32_t b, uint8_t s);
 extern "C" int32_t ll_curve_mul_q30(int32_t a, int32_t b);
 asm(".section .text.ll_curve_mul_shift,\"ax\",@progbits\n"
@@ -83,9 +85,21 @@ asm(".section .text.ll_curve_mul_shift,\"ax\",@progbits\n"
     "pop  r16\n"
     "pop  r15\n"
     "pop  r14\n"
+    "cpi  r26, 30\n" // mul_q30: bytes 3 to 7 shifted left twice (s counts to 32)
+    "brne 4f\n"
+    "8:\n"
+    "lsl  r21\n"
+    "rol  r22\n"
+    "rol  r23\n"
+    "rol  r24\n"
+    "rol  r25\n"
+    "inc  r26\n"
+    "sbrc r26, 0\n"
+    "rjmp 8b\n"
+    "ret\n"
     "4:\n"
-    "cpi  r26, 8\n"
-    "brlo 5f\n"
+    "subi r26, 8\n"
+    "brcs 5f\n"
     "mov  r18, r19\n"
     "mov  r19, r20\n"
     "mov  r20, r21\n"
@@ -93,10 +107,9 @@ asm(".section .text.ll_curve_mul_shift,\"ax\",@progbits\n"
     "mov  r22, r23\n"
     "mov  r23, r24\n"
     "mov  r24, r25\n"
-    "subi r26, 8\n"
     "rjmp 4b\n"
     "5:\n"
-    "tst  r26\n"
+    "subi r26, -8\n" // the bits left, s mod 8
     "breq 7f\n"
     "6:\n"
     "lsr  r25\n"
@@ -345,15 +358,13 @@ inline const int32_t (*ends_of(const CurveWalker::Ends& e))[2] {
 // One sample of a cubic by forward differencing: f += d1, d1 += d2, d2 += d3 (v = f, d1, d2, d3).
 inline void fd_step(int64_t v[4]) {
 #if defined(__AVR__)
-    // Byte by byte in place, each sum with the next value's old bytes (8 bytes on), two bytes a
-    // turn: about 215 cycles and 36 bytes, where avr-gcc calls __adddi3 three times through long
-    // register moves.
-    uint8_t n, k, x, y;
+    // Byte by byte in place, each sum with the next value's old bytes (8 bytes on), a whole sum
+    // a turn: 180 cycles and 72 bytes (four bytes a turn: 200 cycles and 46 bytes), where
+    // avr-gcc calls __adddi3 three times through long register moves.
+    uint8_t n, x, y;
     asm volatile("ldi  %[n], 3\n"
                  "1:\n\t"
-                 "ldi  %[k], 2\n\t"
-                 "clc\n"
-                 "2:\n\t"
+                 "clc\n\t"
                  "ld   %[x], Z\n\t"
                  "ldd  %[y], Z+8\n\t"
                  "adc  %[x], %[y]\n\t"
@@ -370,11 +381,25 @@ inline void fd_step(int64_t v[4]) {
                  "ldd  %[y], Z+8\n\t"
                  "adc  %[x], %[y]\n\t"
                  "st   Z+, %[x]\n\t"
-                 "dec  %[k]\n\t"
-                 "brne 2b\n\t"
+                 "ld   %[x], Z\n\t"
+                 "ldd  %[y], Z+8\n\t"
+                 "adc  %[x], %[y]\n\t"
+                 "st   Z+, %[x]\n\t"
+                 "ld   %[x], Z\n\t"
+                 "ldd  %[y], Z+8\n\t"
+                 "adc  %[x], %[y]\n\t"
+                 "st   Z+, %[x]\n\t"
+                 "ld   %[x], Z\n\t"
+                 "ldd  %[y], Z+8\n\t"
+                 "adc  %[x], %[y]\n\t"
+                 "st   Z+, %[x]\n\t"
+                 "ld   %[x], Z\n\t"
+                 "ldd  %[y], Z+8\n\t"
+                 "adc  %[x], %[y]\n\t"
+                 "st   Z+, %[x]\n\t"
                  "dec  %[n]\n\t"
                  "brne 1b"
-                 : "+z"(v), [n] "=&d"(n), [k] "=&d"(k), [x] "=&r"(x), [y] "=&r"(y)
+                 : "+z"(v), [n] "=&d"(n), [x] "=&r"(x), [y] "=&r"(y)
                  :
                  : "memory");
 #else
@@ -386,7 +411,8 @@ inline void fd_step(int64_t v[4]) {
 
 // acc += x / 2^s in Q40 for x in Q8 (s <= 36): exact for s <= 32, floored beyond.
 #if defined(__AVR__)
-// In assembly: the addend in two words (x, 0) shifted together, then added byte by byte. avr-gcc
+// In assembly: the addend in two words (x, 0) shifted together (whole bytes by moves, the rest
+// bit by bit: a piece's shifts reach 3 m bits), then added byte by byte. avr-gcc
 // would call the 64-bit shift and sum routines of its library, which nothing else in the image
 // needs.
 extern "C" void ll_curve_add_q40(int64_t& acc, int32_t x, uint8_t s);
@@ -400,7 +426,21 @@ asm(".section .text.ll_curve_add_q40,\"ax\",@progbits\n"
     "clr  r18\n"
     "clr  r19\n"
     "movw r20, r18\n"
-    "tst  r30\n"
+    "0:\n" // whole bytes by moves first
+    "subi r30, 8\n"
+    "brcs 3f\n"
+    "mov  r18, r19\n"
+    "mov  r19, r20\n"
+    "mov  r20, r21\n"
+    "mov  r21, r22\n"
+    "mov  r22, r23\n"
+    "mov  r23, r24\n"
+    "mov  r24, r25\n"
+    "lsl  r25\n"
+    "sbc  r25, r25\n"
+    "rjmp 0b\n"
+    "3:\n"
+    "subi r30, -8\n" // the bits left, s mod 8
     "breq 2f\n"
     "1:\n"
     "asr  r25\n"
@@ -500,8 +540,8 @@ int64_t arc_sweep_q29(int32_t c0, int32_t s0, int32_t c1, int32_t s1, bool clock
 
 void CurveWalker::begin(const Ends& e, uint16_t pieces, uint8_t kind) {
     piece_count_ = pieces_ = pieces;
-    memcpy(pos, e.start, sizeof(pos));
-    memcpy(end_, e.end, sizeof(end_));
+    static_assert(offsetof(Ends, end) == offsetof(Ends, start) + sizeof(pos), "in a row");
+    memcpy(pos, e.start, sizeof(pos) + sizeof(end_)); // and end_ (curve.h)
     // (The start of the curve in the plane, prev_q8_[0..1], is set by next_piece().)
     // w moves linearly along the curve (a helix); without it, only u and v are walked.
     prev_q8_[2] = w0_q8_ = e.start[2] * 256;
@@ -517,9 +557,14 @@ __attribute__((always_inline)) inline void CurveWalker::start_piece(Piece& g) {
     // c3 = arm0 + arm3 - 2 D and c2 = D - c1 - c3, D = p3 - p0 (in place of arm0, p3 and arm3).
     memset(fd_, 0, sizeof(fd_));
     uint32_t bound = 0; // largest axis speed over the piece, ticks x 256 per unit of t
-    for (uint8_t a = 0; a < 3; ++a) {
+    // (w's coefficients are zero on a curve of two axes, whose w never moves: its differences
+    // stay the zeros above, and next() never reads them.)
+    const uint8_t axes = axes_;
+    for (uint8_t a = 0; a < axes; ++a) {
         // f: where the piece starts, ticks x 2^40 (the points are within 2^22 ticks of zero).
-        memcpy(reinterpret_cast<uint8_t*>(fd_[a]) + 4, &prev_q8_[a], 4);
+        // (Plus half a tick: next() rounds by taking the ticks' bits alone.)
+        const int32_t f = prev_q8_[a] + 128;
+        memcpy(reinterpret_cast<uint8_t*>(fd_[a]) + 4, &f, 4);
         const int32_t d = g.v[kP3][a] - prev_q8_[a];
         prev_q8_[a] = g.v[kP3][a];
         const int32_t c1 = g.v[kArm0][a];
@@ -539,7 +584,7 @@ __attribute__((always_inline)) inline void CurveWalker::start_piece(Piece& g) {
         samples = static_cast<uint16_t>(samples << 1);
     }
     left_ = samples;
-    for (uint8_t a = 0; a < 3; ++a) {
+    for (uint8_t a = 0; a < axes; ++a) {
         int64_t* v = fd_[a];
         // The differences at t = 0 for the step 1/N: c1/N + c2/N^2 + c3/N^3,
         // 2 c2/N^2 + 6 c3/N^3, 6 c3/N^3, term by term (c_pw / N^pw into the differences 1 to pw).
@@ -651,11 +696,12 @@ bool CurveWalker::next_piece() {
     int32_t *p3 = g.v[kP3], *arm0 = g.v[kArm0], *arm3 = g.v[kArm3];
     // Helix: w moves linearly (arms of a third of its move), the last piece landing exactly on
     // the end.
-    int32_t w3 = dw_q8_;
-    if (!last) {
+    const int32_t dw = dw_q8_;
+    int32_t w3 = dw;
+    if (!last && dw != 0) { // (w moves: a helix)
         w3 = static_cast<int32_t>(
-            Num(abs32(dw_q8_)).mul(static_cast<uint32_t>(index) + 1).div(piece_count_).u32());
-        if (dw_q8_ < 0) w3 = -w3;
+            Num(abs32(dw)).mul(static_cast<uint32_t>(index) + 1).div(piece_count_).u32());
+        if (dw < 0) w3 = -w3;
     }
     p3[2] = w3 + w0_q8_;
     arm0[2] = arm3[2] = p3[2] - prev_q8_[2];
@@ -685,7 +731,6 @@ bool CurveWalker::next_piece() {
 }
 
 bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
-    save_run_from_r8();
     // Past the last piece: the last step, from the rounded end of the curve to the exact target
     // (at most one tick per axis: both are within 0.71 tick of the curve's end point); once made
     // (the position is the end), no step and false.
@@ -698,15 +743,20 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
         if (walking) {
             int64_t* v = fd_[a];
             fd_step(v);
-            // round(f / 2^40) from the high word: floor((hi + 2^7) / 2^8). The word is read
-            // from memory: avr-gcc would shift the 64 bits through a library loop.
+            // round(f / 2^40) from the high word of f + 2^39 (start_piece): floor(hi / 2^8).
+            // The word is read from memory: avr-gcc would shift the 64 bits through a library
+            // loop.
             int32_t hi;
             memcpy(&hi, reinterpret_cast<const uint8_t*>(v) + 4, 4);
-            p = (hi + 128) >> 8;
+            p = hi >> 8;
         }
-        if (p != pos[a]) {
+        // Compared on the low bytes (the same whenever the two are less than 128 ticks apart):
+        // a sample is at most a tick from the last, and so is the end from the last sample.
+        const int8_t diff =
+            static_cast<int8_t>(static_cast<uint8_t>(p) - static_cast<uint8_t>(pos[a]));
+        if (diff != 0) {
             bits = static_cast<uint8_t>(bits | bit);
-            if (p < pos[a]) down = static_cast<uint8_t>(down | bit);
+            if (diff < 0) down = static_cast<uint8_t>(down | bit);
             pos[a] = p;
         }
     }
@@ -717,13 +767,31 @@ bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
     return true;
 }
 
-uint16_t CurveWalker::peek(int32_t d[3]) {
-    if (left_ == 0 && kind_ != 0) next_piece(); // (a piece has at least one sample)
+void CurveWalker::chord(int32_t d[3]) const {
     // d1 / 2^24 (below 2^17): bits 24 to 55 of the little-endian word.
     for (uint8_t a = 0; a < 3; ++a) {
         memcpy(&d[a], reinterpret_cast<const uint8_t*>(&fd_[a][1]) + 3, 4);
     }
-    return left_;
+}
+
+// (Here, not in the step generator: the displacement is read in place, and the Num values are in
+// this frame, not in fill_curve()'s while the walker steps below it.)
+uint32_t CurveWalker::chord_q8(uint8_t timed, const uint8_t machine[3], const Num inv2[]) const {
+    Num sum{};
+    for (uint8_t k = 0; k < 3; ++k, timed = static_cast<uint8_t>(timed >> 1)) {
+        if (!(timed & 1)) continue;
+        // d1 / 2^24, ticks x 2^16 (as chord() gives it)
+        int32_t d;
+        memcpy(&d, reinterpret_cast<const uint8_t*>(&fd_[k][1]) + 3, 4);
+        Num v(abs32(d));
+        v.mul(v).mul(inv2[machine[k]]);
+        sum.add(v);
+    }
+    // mm over 2^16 -> µm x 256: x 256000 / 2^16 = 0xFA000000 x 2^-30 (mul() would take 256000
+    // as 0xFA000000 x 2^-14, then the shift)
+    uint32_t len = sum.sqrt().mulc(0xFA000000ul, -30).u32();
+    if (len == 0) len = 1;
+    return len;
 }
 
 namespace {
@@ -993,7 +1061,8 @@ bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& o
     int8_t scale;
     uint32_t span = kOneQ29;
     uint8_t turns = 0;
-    uint32_t circle_r = 0; // a circle's radius (0: not a circle)
+    bool circle = false;
+    Num len{};
     // w rises by |dw| per unit of the parameter: a Bezier's t, or (below) an arc's radian.
     k.rise.set(abs32(dw_um));
     if (cp.kind == kCurveArc) {
@@ -1004,13 +1073,29 @@ bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& o
         if (span == 0) return false; // a null radius
         turns = cp.turns;
         // w rises linearly with the angle: dw / |sweep| per radian.
-        k.rise.div(Num(kTurnQ29, -29).mul(turns).add(Num(span, -29)));
+        Num ld[2]; // |sweep| (radians), and |dw| for a circle's length below
+        ld[1] = k.rise;
+        ld[0].set(kTurnQ29, -29).mul(turns).add(Num(span, -29));
+        k.rise.div(ld[0]);
         memcpy(k.e.r, r, sizeof(k.e.r));
         scale = normalise(k.e.r, 2);
         const uint32_t hi = larger(r);
         const uint32_t lo = r[0] ^ r[1] ^ hi;
         out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
-        if (lo == hi) circle_r = lo;
+        if (lo == hi) {
+            // A circle in closed form: r |sweep|, and a circular helix sqrt(plane^2 + dw^2).
+            // (The quadrature gives the same to 1e-7, its speed being constant, but at ~20 times
+            // the cycles: 0.7 M for a whole circle instead of 37 k, too slow for streams of short
+            // arcs.)
+            circle = true;
+            ld[0].mul(lo);
+            if (w_regulated) {
+                root_sum_squares(ld, 2, len);
+            } else {
+                len = ld[0];
+            }
+            len.shift(8); // um x 256
+        }
     } else {
         // Hodograph B'(t) = h0 + t (h1 + t h2): 3 D1, 6 D2, 3 D3 from the forward differences of
         // the points. The G-code checks (error:33) keep the control polygon below 2^23 µm, so
@@ -1038,21 +1123,7 @@ bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& o
     k.rise.shift(scale);
     k.w_counts = w_regulated;
     tangent(k, out.start_dir);
-    Num len{};
-    if (circle_r != 0) {
-        // A circle in closed form: r |sweep|, and a circular helix sqrt(plane^2 + dw^2). (The
-        // quadrature gives the same to 1e-7, its speed being constant, but at ~20 times the
-        // cycles: 0.7 M for a whole circle instead of 37 k, too slow for streams of short arcs.)
-        Num ld[2];
-        ld[0].set(kTurnQ29, -29).mul(turns).add(Num(span, -29)).mul(circle_r);
-        ld[1].set(abs32(dw_um));
-        if (w_regulated) {
-            root_sum_squares(ld, 2, len);
-        } else {
-            len = ld[0];
-        }
-        len.shift(8); // um x 256
-    } else {
+    if (!circle) {
         track_length(k, span, len);
         // An ellipse's extra turns: a full turn from wherever.
         if (turns) {

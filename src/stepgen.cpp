@@ -598,28 +598,7 @@ void StepGen::fill_curve(RunQueue& q) {
         if (horizon_full(q)) break;
         // The chord of the next sample sets the time of every sample of the segment (the
         // segment never crosses into the next piece, whose samples may be twice as long).
-        int32_t d[3];
-        uint16_t left = cv_.w.peek(d);
-        // The chord changes slowly along a piece: computed again (a square root) when a piece
-        // starts and every 8 samples, not for every segment (chord_left: the samples left in
-        // the piece when it was computed, 0: none yet).
-        uint32_t chord_q8 = cv_.chord_q8;
-        const uint16_t since = static_cast<uint16_t>(cv_.chord_left - left);
-        const bool fresh = cv_.chord_left == 0 || left > cv_.chord_left || since >= 8;
-        if (fresh) {
-            Num sum{};
-            uint8_t chord = cv_.chord;
-            for (uint8_t k = 0; k < 3; ++k, chord >>= 1) {
-                if (!(chord & 1)) continue;
-                Num v(abs32(d[k]));
-                v.mul(v).mul(lengths_->inv2[cv_.axes[k]]);
-                sum.add(v);
-            }
-            // mm over 2^16 -> µm x 256: x 256000 / 2^16 = 0xFA000000 x 2^-30 (mul() would take
-            // 256000 as 0xFA000000 x 2^-14, then the shift)
-            chord_q8 = sum.sqrt().mulc(0xFA000000ul, -30).u32();
-            if (chord_q8 == 0) chord_q8 = 1;
-        }
+        const uint16_t left = cv_.w.peek();
         // The segment's length depends on the speed only, never on how full the queue is (the
         // chip and the host model must cut the same segments): wait for room for all of it.
         // At most 3 samples (6 runs in the worst case), so that the queue is still half full
@@ -627,7 +606,22 @@ void StepGen::fill_curve(RunQueue& q) {
         constexpr uint8_t kMaxSamples = 3;
         uint8_t n = seg_len_ < kMaxSamples ? seg_len_ : kMaxSamples;
         if (left != 0 && left < n) n = static_cast<uint8_t>(left);
+        // (Tested before the chord is read or computed: a segment that waits costs no more.)
         if (q.free_slots() < 2 * n + 2) break;
+        // The chord changes slowly along a piece: computed again (a square root) when a piece
+        // starts and every 8 samples, not for every segment (chord_left: the samples left in
+        // the piece when it was computed, 0: none yet). One test covers the three cases: the
+        // samples since then wrap around to 2^16 - left or more (a piece has at most 4096) when
+        // there is no chord yet (left >= 1 then) or a new piece has started (left > chord_left).
+        // Kept at once: the room is there, so the segment is made unless the speed reaches zero
+        // first (a hold), and then the same samples are still next and have the same chord. (The
+        // chip and the host model stop at different times for room, and must still use the same
+        // chord for the same samples.)
+        if (static_cast<uint16_t>(cv_.chord_left - left) >= 8) {
+            cv_.chord_q8 = cv_.w.chord_q8(cv_.chord, cv_.axes, lengths_->inv2);
+            cv_.chord_left = left;
+        }
+        const uint32_t chord_q8 = cv_.chord_q8;
         uint32_t mid = cv_.x_q8 + chord_q8 * n / 2;
         const uint32_t delta = delta_at(2 * (mid >> 8));
         if (stopped_) break;
@@ -639,11 +633,19 @@ void StepGen::fill_curve(RunQueue& q) {
         // rotation of the three bits by plane = 2 - axes[2] to the right, once per run.
         const uint8_t plane = static_cast<uint8_t>(2 - cv_.axes[2]);
         uint8_t run_moved = 0, run_neg = 0, run_count = 0;
-        // One emit() for both ends of a run: a sample that differs, or none left.
-        uint8_t i = 0;
-        for (;; ++i) {
-            uint8_t moved = 0, neg = 0;
-            const bool more = i < n && cv_.w.next(moved, neg);
+        // The runs of a segment share its period: rounded and clamped here once, and pushed as
+        // emit() would when it fits 16 bits (else emit() makes each run's idle waits). emit()
+        // cost 290 cycles a run, push() costs 74.
+        static_assert(0xFFFF00ul < kMaxPeriodCycles << 8, "a whole period is never capped");
+        static_assert((kMaxSamples * 0xFFFFul) >> 10 <= 255, "a run's time never saturates");
+        const bool whole = period_q8 <= 0xFFFF00ul;
+        uint16_t p16 = static_cast<uint16_t>((period_q8 + 128) >> 8);
+        const bool clamped = p16 < min_period_;
+        if (clamped) p16 = min_period_;
+        // One push for both ends of a run: a sample that differs, or none left.
+        for (;; --n) {
+            uint8_t moved, neg; // (read only when next() has set them)
+            const bool more = n != 0 && cv_.w.next(moved, neg);
             if (run_count != 0 && (!more || moved != run_moved || (moved && neg != run_neg))) {
                 uint8_t steps = static_cast<uint8_t>(run_moved * 9u);
                 uint8_t dirs = static_cast<uint8_t>(run_neg * 9u);
@@ -651,23 +653,28 @@ void StepGen::fill_curve(RunQueue& q) {
                     steps = static_cast<uint8_t>(steps >> 1);
                     dirs = static_cast<uint8_t>(dirs >> 1);
                 }
-                emit(q, static_cast<uint8_t>(steps & 7), static_cast<uint8_t>(dirs & 7), run_count,
-                     period_q8);
+                steps = static_cast<uint8_t>(steps & 7);
+                dirs = static_cast<uint8_t>(dirs & 7);
+                if (whole) {
+                    // (as emit() counts a run's time)
+                    const uint8_t units = static_cast<uint8_t>(
+                        static_cast<uint16_t>((static_cast<uint32_t>(p16) * run_count) >> 8) >> 2);
+                    push(q, steps, dirs, run_count, p16, units);
+#if LL_STATS
+                    if (clamped) ++stats.clamped;
+#endif
+                } else {
+                    emit(q, steps, dirs, run_count, period_q8);
+                }
                 run_count = 0;
             }
             if (!more) break;
             if (run_count == 0) {
                 run_moved = moved;
-                run_neg = moved ? neg : run_neg;
+                if (moved) run_neg = neg;
             }
             ++run_count;
-        }
-        cv_.x_q8 += chord_q8 * i;
-        // Kept only for a segment actually made: the chip and the host model stop at different
-        // times for room, and must still use the same chord for the same samples.
-        if (fresh) {
-            cv_.chord_q8 = chord_q8;
-            cv_.chord_left = left;
+            cv_.x_q8 += chord_q8; // (a sum a sample: no product)
         }
 #if LL_STATS
         ++stats.segments;
@@ -676,7 +683,7 @@ void StepGen::fill_curve(RunQueue& q) {
         // samples it may, one when a sample needs idle waits. (This is what next_segment() gives
         // for 8x the line segment duration without a speed limit: at least 4 up to a period of
         // 0xFFFF cycles, else 1; without its call, 280 cycles less a segment.)
-        seg_len_ = period_q8 <= 0xFFFF00ul ? kMaxSamples : 1;
+        seg_len_ = whole ? kMaxSamples : 1;
         if (cv_.w.done()) {
             seg_len_ = 1;
             finish_move();

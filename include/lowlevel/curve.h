@@ -22,6 +22,8 @@
 
 namespace ll {
 
+struct Num;
+
 enum : uint8_t { kCurveArc = 1, kCurveBezier = 2 };
 
 /// The axes of a plane: u and v span it, w is its normal (the helix axis). G17: (X, Y, Z),
@@ -103,10 +105,28 @@ class CurveWalker {
     /// that sample's displacement, ticks x 2^16 per axis: its chord, from which the step
     /// generator times it. Returns the samples left in the piece (0: only the final step to
     /// the exact end remains, or nothing at all).
-    uint16_t peek(int32_t d[3]);
+    uint16_t peek(int32_t d[3]) {
+        const uint16_t left = peek();
+        chord(d);
+        return left;
+    }
+    /// peek() in two parts, for a step generator that needs the displacement now and then only:
+    /// the samples left (making the next sample's piece current), and the displacement.
+    uint16_t peek() {
+        if (left_ == 0 && kind_ != 0) next_piece(); // (a piece has at least one sample)
+        return left_;
+    }
+    void chord(int32_t d[3]) const;
+    /// The length of the next sample (its chord) along the axes whose bit (u = 1, v = 2,
+    /// w = 4) is set in `timed`, µm x 256, at least 1: sqrt(sum of d^2 / T^2) for the machine
+    /// axes `machine[k]` of step lengths T (`inv2`: 1/T^2, mm^2 per step^2, per machine axis).
+    uint32_t chord_q8(uint8_t timed, const uint8_t machine[3], const Num inv2[]) const;
     bool done() const { return kind_ == 0; }
 
     int32_t pos[3]; ///< current position, ticks (u, v, w)
+    // The walker's own (public only to follow pos in memory, as Ends' start and end do: begin()
+    // copies both in one piece).
+    int32_t end_[3]; ///< final position, ticks
 
   private:
     void begin(const Ends& e, uint16_t pieces, uint8_t kind);
@@ -132,7 +152,6 @@ class CurveWalker {
     uint8_t log_pieces_;    ///< Bezier: 2^j pieces
     int32_t w0_q8_, dw_q8_; ///< helix: w at the start, and its change over the curve
     int32_t prev_q8_[3];    ///< end of the last piece started (start of the next), ticks x 256
-    int32_t end_[3];        ///< final position, ticks
     // An arc or a Bezier, never both.
     struct ArcState {
         int32_t centre[2];
