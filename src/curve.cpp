@@ -27,6 +27,13 @@ constexpr uint32_t kTurnQ29 = 2ul * kPiQ29;
 // 0.02 tick.
 constexpr uint32_t kMaxPieceTicks = 2000;
 
+// The fewest pieces that keep a helix' rise within kMaxPieceTicks a piece (w moves dw / n
+// linearly; 1 on a curve of two axes). A steep helix would otherwise get pieces of 2^16
+// samples, whose 16-bit count wraps: its rise was lost.
+__attribute__((noinline)) uint32_t rise_pieces(const CurveWalker::Ends& e) {
+    return div32_16(abs32(e.end[2] - e.start[2]), kMaxPieceTicks) + 1;
+}
+
 #if defined(__AVR__)
 // floor(a b / 2^s) for s <= 32 (mul_q30: s = 30), the result within 32 bits. The unsigned product
 // of fixmath's multiplier (__ll_mul32, its own register convention) made signed (a negative
@@ -620,12 +627,14 @@ bool CurveWalker::arc(const Ends& e, const int32_t centre_q8[2], const uint32_t 
     uint32_t mag = arc_directions(ends_of(e), a_.centre, a_.radii, clockwise, a_.dir);
     if (mag == 0) return false; // a null radius
     mag = (mag >> 9) + turns * (kTurnQ29 >> 9);
-    // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees) and kMaxPieceTicks long (sweep x
-    // radius ticks).
+    // Pieces: at most 3 x 2^17 / 2^20 rad (21.5 degrees), kMaxPieceTicks long (sweep x radius
+    // ticks) and rising at most as much (rise_pieces()).
     uint32_t rmax = larger(a_.radii) >> 8;
     // (x / 3 for x = mag / 2^17 below 2^14, by its reciprocal: a division is a library call.)
     uint32_t n = ((mag >> 17) * 21846ul >> 16) + 1u;
     uint32_t by_length = Num(mag, -20).mul(rmax + 1).div(kMaxPieceTicks).u32() + 1;
+    if (by_length > n) n = by_length;
+    by_length = rise_pieces(e);
     if (by_length > n) n = by_length;
     if (n > 0xFFFF) return false;
     // Piece angle h, Q30 (at most 21.5 degrees, so the series apply), and 3 x the arm of its
@@ -673,10 +682,12 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
         if (b > bound) bound = b;
     }
     bound *= 3;
-    // 2^j pieces, each with a hodograph bound below kMaxPieceTicks (it shrinks with 2^j).
+    // 2^j pieces, each with a hodograph bound below kMaxPieceTicks (it shrinks with 2^j), and
+    // as many as a helix' rise needs.
+    const uint32_t need = rise_pieces(e);
     uint8_t j = 0;
     uint16_t n = 1;
-    for (; bound >= kMaxPieceTicks; bound >>= 1) {
+    for (; bound >= kMaxPieceTicks || n < need; bound >>= 1) {
         if (j == 15) return false;
         ++j;
         n = static_cast<uint16_t>(n << 1);

@@ -176,6 +176,34 @@ TEST(Curve, HelicalArcMovesTheNormalAxisLinearlyWithTheAngle) {
     EXPECT_LE(res.worst, 1.0);
 }
 
+TEST(Curve, SteepHelicesStepEveryTickOfTheNormalAxis) {
+    // Pieces are also bounded by the normal axis' travel: a short arc or Bezier that rises far
+    // (a steep helix) used to get pieces of 2^16 samples, whose 16-bit count wrapped to 0 and
+    // lost the rise (the walker jumped to the end).
+    for (int32_t rise : {40000, 200000, -70000}) {
+        // A quarter arc of radius 100 ticks.
+        int32_t start[3] = {100, 0, 0}, end[3] = {0, 100, rise};
+        int32_t c[2] = {0, 0};
+        uint32_t rad[2] = {100 * 256, 100 * 256};
+        ll::CurveWalker w{};
+        ASSERT_TRUE(w.arc(ends(start, end, 100, 0, 0, 100), c, rad, false, 0)) << rise;
+        Result res = walk(w, end, [](const int32_t*) { return 0.0; });
+        EXPECT_TRUE(res.successive) << rise;
+        EXPECT_TRUE(res.ended) << rise;
+        EXPECT_GE(res.samples, std::abs(rise)) << rise; // one tick of w at most per sample
+        // A Bezier of about 80 ticks with the same rise.
+        int32_t bstart[3] = {0, 0, 0}, bend[3] = {80, 0, rise};
+        ll::CurveWalker b{};
+        ll::CurveWalker::Ends e = ends(bstart, bend, 0, 0, 80, 0);
+        int32_t p1[2] = {20 * 256, 30 * 256}, p2[2] = {60 * 256, 30 * 256};
+        ASSERT_TRUE(b.bezier(e, p1, p2)) << rise;
+        Result rb = walk(b, bend, [](const int32_t*) { return 0.0; });
+        EXPECT_TRUE(rb.successive) << rise;
+        EXPECT_TRUE(rb.ended) << rise;
+        EXPECT_GE(rb.samples, std::abs(rise)) << rise;
+    }
+}
+
 TEST(Curve, ExtraTurnsAddFullCircles) {
     int32_t start[3] = {100, 0, 0}, end[3] = {0, 100, 0};
     int32_t c[2] = {0, 0};
