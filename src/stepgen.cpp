@@ -610,16 +610,19 @@ void StepGen::fill_curve(RunQueue& q) {
         if (q.free_slots() < 2 * n + 2) break;
         // The chord changes slowly along a piece: computed again (a square root) when a piece
         // starts and every 8 samples, not for every segment (chord_left: the samples left in
-        // the piece when it was computed, 0: none yet). One test covers the three cases: the
-        // samples since then wrap around to 2^16 - left or more (a piece has at most 4096) when
-        // there is no chord yet (left >= 1 then) or a new piece has started (left > chord_left).
+        // the piece when it was computed, 0: none yet). The samples since then wrap around to
+        // 2^16 - left or more (a piece has at most 4096) when there is no chord yet (left >= 1
+        // then) or a new piece has more samples than were left; a new piece of fewer samples
+        // (a small curve's pieces have 4 to 8) is told by the walker's piece tag.
         // Kept at once: the room is there, so the segment is made unless the speed reaches zero
         // first (a hold), and then the same samples are still next and have the same chord. (The
         // chip and the host model stop at different times for room, and must still use the same
         // chord for the same samples.)
-        if (static_cast<uint16_t>(cv_.chord_left - left) >= 8) {
+        if (static_cast<uint16_t>(cv_.chord_left - left) >= 8 ||
+            cv_.chord_piece != cv_.w.piece_tag()) {
             cv_.chord_q8 = cv_.w.chord_q8(cv_.chord, cv_.axes, lengths_->inv2);
             cv_.chord_left = left;
+            cv_.chord_piece = cv_.w.piece_tag();
         }
         const uint32_t chord_q8 = cv_.chord_q8;
         uint32_t mid = cv_.x_q8 + chord_q8 * n / 2;

@@ -122,6 +122,9 @@ class CurveWalker {
     /// axes `machine[k]` of step lengths T (`inv2`: 1/T^2, mm^2 per step^2, per machine axis).
     uint32_t chord_q8(uint8_t timed, const uint8_t machine[3], const Num inv2[]) const;
     bool done() const { return kind_ == 0; }
+    /// Changes with every piece (the low byte of the pieces not started yet): tells a piece of
+    /// few samples from the one before it, where the samples left alone cannot.
+    uint8_t piece_tag() const { return static_cast<uint8_t>(pieces_); }
 
     int32_t pos[3]; ///< current position, ticks (u, v, w)
     // The walker's own (public only to follow pos in memory, as Ends' start and end do: begin()

@@ -258,9 +258,9 @@ class StepGen {
         uint32_t x_q8;       ///< distance travelled, µm x 256
         uint8_t axes[3];     ///< machine axes u, v, w
         uint8_t chord;       ///< bits (u = 1, v = 2, w = 4) of the axes the path is timed along
-        bool circle;         ///< every sample of a piece has the same chord (a circle or helix)
-        uint16_t chord_left; ///< circle: samples that were left in the piece at the last chord
-        uint32_t chord_q8;   ///< circle: that chord, µm x 256
+        uint8_t chord_piece; ///< the walker's piece_tag() at the last chord
+        uint16_t chord_left; ///< samples that were left in the piece at the last chord
+        uint32_t chord_q8;   ///< that chord, µm x 256
         CurveWalker w;
     };
     union {
