@@ -742,6 +742,7 @@ bool CurveWalker::next_piece() {
 }
 
 bool CurveWalker::next(uint8_t& moved, uint8_t& neg) {
+    // One sample: at most one tick per axis (seed §9's micro steps along the curve).
     // Past the last piece: the last step, from the rounded end of the curve to the exact target
     // (at most one tick per axis: both are within 0.71 tick of the curve's end point); once made
     // (the position is the end), no step and false.

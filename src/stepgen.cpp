@@ -591,6 +591,8 @@ void StepGen::fill_line(RunQueue& q) {
     }
 }
 
+// A curve's samples, timed along the path as the reference axis (seed §10.2): each sample
+// waits its chord's length at the profile's speed.
 void StepGen::fill_curve(RunQueue& q) {
     while (active_ && !stopped_) {
         // Worst case of one segment: every sample its own run, each possibly split in two; a
