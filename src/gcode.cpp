@@ -496,7 +496,8 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
     uint32_t spu_min = 0xFFFFFFFFu;
     for (uint8_t i = 0; i < 8; ++i) {
         int32_t steps;
-        uint8_t a = ax[i & 1];
+        uint8_t a = ax[0]; // ax[i & 1], without the computed index (12 B)
+        if (i & 1) a = ax[1];
         uint32_t spu = g_settings.axis[a].steps_per_unit;
         if (spu < spu_min) spu_min = spu;
         // (|steps| > 2^22 as one unsigned comparison: steps + 2^22 wraps above 2^23. A result
@@ -513,6 +514,9 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
     if (c.kind == kCurveBezier) {
         // The control polygon start, a, b, end: points 0 2 3 1 of the row, 2 bits each.
         for (uint8_t seq = 0x1E, prev = 0; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
+            asm(""
+                : "+r"(seq)); // (the loop runs on seq, not on a 16-bit trip count the compiler
+                              // adds: 16 B)
             uint8_t i = seq & 3;
             uint32_t d[2];
             combine2(reinterpret_cast<int32_t*>(d), row + 2 * i, row + 2 * prev, kMagnitudes);
