@@ -679,7 +679,11 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
     for (uint8_t k = 0; k < 2; ++k) {
         // B'(a) = 3 D1 + 6 D2 a + 3 D3 a^2 (D: the forward differences of the points, ticks).
         int32_t d[4];
-        for (uint8_t i = 0; i < 4; ++i) d[i] = (pts_[k][i] = src[i][k]) >> 8;
+        for (uint8_t i = 0; i < 4; ++i) {
+            const int32_t* p = src[i]; // src[i][k], without a 16-bit byte offset counted by k
+            if (k) ++p;
+            d[i] = (pts_[k][i] = *p) >> 8;
+        }
         differences(d);
         uint32_t b = abs32(d[2]);
         b += b + abs32(d[1]);
@@ -1097,7 +1101,7 @@ bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& o
         memcpy(k.e.r, r, sizeof(k.e.r));
         scale = normalise(k.e.r, 2);
         const uint32_t hi = larger(r);
-        const uint32_t lo = r[0] ^ r[1] ^ hi;
+        const uint32_t lo = min32(r[0], r[1]);             // (the planner's copy)
         out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
         if (lo == hi) {
             // A circle in closed form: r |sweep|, and a circular helix sqrt(plane^2 + dw^2).
