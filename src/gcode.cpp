@@ -465,6 +465,7 @@ __attribute__((noinline)) uint32_t dist_um(const int32_t p[2], const int32_t q[2
 __attribute__((noinline)) void axes_of(uint8_t plane, uint8_t ax[3]) {
     uint8_t a = static_cast<uint8_t>(3 - plane); // 3 for G17: wraps to 0 at once
     for (uint8_t k = 3; k != 0; --k) {
+        asm("" : "+r"(k)); // (counted in k: the compiler would compare the pointer instead)
         if (a == 3) a = 0;
         *ax++ = a++;
     }
@@ -1021,6 +1022,7 @@ void report_offsets() {
     // G54 is real, G55..G59, G28 and G30 are zeros (not supported), then G92.
     static const uint8_t kCodes[9] LL_PROGMEM = {54, 55, 56, 57, 58, 59, 28, 30, 92};
     for (uint8_t i = 0; i < sizeof(kCodes); ++i) {
+        asm("" : "+r"(i)); // (counted in i, not by a 16-bit address compare)
         uint8_t code = flash_read_byte(&kCodes[i]);
         out::str(LL_PSTR("[G"));
         out::u8(code);
