@@ -1125,9 +1125,9 @@ bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& o
             // The points start, a, b, end: 0, 2, 3, 1 of the row (start end a b, as the G-code
             // checks pin it), 2 bits each.
             int32_t q[4];
-            const int32_t* row = cp.start_um;
+            const int32_t* row = cp.start_um + i; // (coordinate i of each point: no index add)
             for (uint8_t j = 0, seq = 0x78; j < 4; ++j, seq = static_cast<uint8_t>(seq >> 2)) {
-                q[j] = row[2 * (seq & 3) + i];
+                q[j] = row[2 * (seq & 3)];
             }
             differences(q);
             for (uint8_t j = 0; j < 3; ++j) {
