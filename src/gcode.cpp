@@ -514,15 +514,15 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
     Num reach{};                               // length bound, um
     if (c.kind == kCurveBezier) {
         // The control polygon start, a, b, end: points 0 2 3 1 of the row, 2 bits each.
-        for (uint8_t seq = 0x1E, prev = 0; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
-            asm(""
-                : "+r"(seq)); // (the loop runs on seq, not on a 16-bit trip count the compiler
-                              // adds: 16 B)
-            uint8_t i = seq & 3;
+        // (The loop runs on seq, not on a 16-bit trip count the compiler would add: the asm.)
+        const int32_t* prev = row;
+        for (uint8_t seq = 0x1E; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
+            asm("" : "+r"(seq));
+            const int32_t* point = row + 2 * (seq & 3);
             uint32_t d[2];
-            combine2(reinterpret_cast<int32_t*>(d), row + 2 * i, row + 2 * prev, kMagnitudes);
+            combine2(reinterpret_cast<int32_t*>(d), point, prev, kMagnitudes);
             reach.add(Num(d[0])).add(Num(d[1]));
-            prev = i;
+            prev = point;
         }
     } else {
         const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
