@@ -344,7 +344,12 @@ __attribute__((noinline)) uint32_t arc_directions(const int32_t ends[2][2], cons
     if (radii[0] == 0 || radii[1] == 0) return 0;
     const int32_t* p = ends[0];
     int32_t* v = dir[0];
-    for (uint8_t i = 0; i < 4; ++i) v[i] = p[i] - centre[i & 1];
+    for (uint8_t i = 0; i < 4; ++i) {
+        // centre[i & 1] as a pointer bumped on odd i (an indexed 32-bit load took 24 B more)
+        const int32_t* c = centre;
+        if (i & 1) ++c;
+        *v++ = *p++ - *c;
+    }
     direction_of(dir[0], radii);
     direction_of(dir[1], radii);
     return sweep_of(dir, clockwise);
@@ -674,7 +679,11 @@ bool CurveWalker::bezier(const Ends& e, const int32_t p1_q8[2], const int32_t p2
     for (uint8_t k = 0; k < 2; ++k) {
         // B'(a) = 3 D1 + 6 D2 a + 3 D3 a^2 (D: the forward differences of the points, ticks).
         int32_t d[4];
-        for (uint8_t i = 0; i < 4; ++i) d[i] = (pts_[k][i] = src[i][k]) >> 8;
+        for (uint8_t i = 0; i < 4; ++i) {
+            const int32_t* p = src[i]; // src[i][k], without a 16-bit byte offset counted by k
+            if (k) ++p;
+            d[i] = (pts_[k][i] = *p) >> 8;
+        }
         differences(d);
         uint32_t b = abs32(d[2]);
         b += b + abs32(d[1]);
@@ -1092,7 +1101,7 @@ bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& o
         memcpy(k.e.r, r, sizeof(k.e.r));
         scale = normalise(k.e.r, 2);
         const uint32_t hi = larger(r);
-        const uint32_t lo = r[0] ^ r[1] ^ hi;
+        const uint32_t lo = min32(r[0], r[1]);             // (the planner's copy)
         out.min_radius_um = Num(lo).mul(lo).div(hi).u32(); // b^2 / a at the flat ends
         if (lo == hi) {
             // A circle in closed form: r |sweep|, and a circular helix sqrt(plane^2 + dw^2).
@@ -1116,9 +1125,9 @@ bool shape(const CurveParams& cp, int32_t dw_um, bool w_regulated, CurveShape& o
             // The points start, a, b, end: 0, 2, 3, 1 of the row (start end a b, as the G-code
             // checks pin it), 2 bits each.
             int32_t q[4];
-            const int32_t* row = cp.start_um;
+            const int32_t* row = cp.start_um + i; // (coordinate i of each point: no index add)
             for (uint8_t j = 0, seq = 0x78; j < 4; ++j, seq = static_cast<uint8_t>(seq >> 2)) {
-                q[j] = row[2 * (seq & 3) + i];
+                q[j] = row[2 * (seq & 3)];
             }
             differences(q);
             for (uint8_t j = 0; j < 3; ++j) {

@@ -465,6 +465,7 @@ __attribute__((noinline)) uint32_t dist_um(const int32_t p[2], const int32_t q[2
 __attribute__((noinline)) void axes_of(uint8_t plane, uint8_t ax[3]) {
     uint8_t a = static_cast<uint8_t>(3 - plane); // 3 for G17: wraps to 0 at once
     for (uint8_t k = 3; k != 0; --k) {
+        asm("" : "+r"(k)); // (counted in k: the compiler would compare the pointer instead)
         if (a == 3) a = 0;
         *ax++ = a++;
     }
@@ -496,7 +497,8 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
     uint32_t spu_min = 0xFFFFFFFFu;
     for (uint8_t i = 0; i < 8; ++i) {
         int32_t steps;
-        uint8_t a = ax[i & 1];
+        uint8_t a = ax[0]; // ax[i & 1], without the computed index (12 B)
+        if (i & 1) a = ax[1];
         uint32_t spu = g_settings.axis[a].steps_per_unit;
         if (spu < spu_min) spu_min = spu;
         // (|steps| > 2^22 as one unsigned comparison: steps + 2^22 wraps above 2^23. A result
@@ -512,12 +514,15 @@ __attribute__((noinline)) bool curve_in_range(const CurveParams& c, bool ellipse
     Num reach{};                               // length bound, um
     if (c.kind == kCurveBezier) {
         // The control polygon start, a, b, end: points 0 2 3 1 of the row, 2 bits each.
-        for (uint8_t seq = 0x1E, prev = 0; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
-            uint8_t i = seq & 3;
+        // (The loop runs on seq, not on a 16-bit trip count the compiler would add: the asm.)
+        const int32_t* prev = row;
+        for (uint8_t seq = 0x1E; seq != 0; seq = static_cast<uint8_t>(seq >> 2)) {
+            asm("" : "+r"(seq));
+            const int32_t* point = row + 2 * (seq & 3);
             uint32_t d[2];
-            combine2(reinterpret_cast<int32_t*>(d), row + 2 * i, row + 2 * prev, kMagnitudes);
+            combine2(reinterpret_cast<int32_t*>(d), point, prev, kMagnitudes);
             reach.add(Num(d[0])).add(Num(d[1]));
-            prev = i;
+            prev = point;
         }
     } else {
         const uint32_t* radii = reinterpret_cast<const uint32_t*>(c.b_um);
@@ -1017,6 +1022,7 @@ void report_offsets() {
     // G54 is real, G55..G59, G28 and G30 are zeros (not supported), then G92.
     static const uint8_t kCodes[9] LL_PROGMEM = {54, 55, 56, 57, 58, 59, 28, 30, 92};
     for (uint8_t i = 0; i < sizeof(kCodes); ++i) {
+        asm("" : "+r"(i)); // (counted in i, not by a 16-bit address compare)
         uint8_t code = flash_read_byte(&kCodes[i]);
         out::str(LL_PSTR("[G"));
         out::u8(code);

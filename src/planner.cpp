@@ -6,10 +6,6 @@
 namespace ll {
 namespace {
 
-__attribute__((noinline)) uint32_t min32(uint32_t a, uint32_t b) {
-    return a < b ? a : b;
-}
-
 // The per-axis limits are read straight from the settings: maximum rates (units/min x1000) and
 // accelerations (units/s^2 x1000, which scale to units/min^2 by x3.6), one field of AxisSettings
 // chosen by a member pointer (an offset: one loop serves both).

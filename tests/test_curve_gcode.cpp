@@ -318,6 +318,16 @@ TEST_F(Curves, FullEllipseStaysWithinThreeQuartersOfAStep) {
     EXPECT_LT(p[50].p[1], 0);
 }
 
+// A G5's path bound is its control polygon (start, a, b, end): 8379 mm passes, 8400 mm is over
+// 2^23 um (error:33). In check mode: no move of a few metres.
+TEST_F(Curves, BezierPathBoundIsItsControlPolygon) {
+    ASSERT_EQ(run("$C"), "[MSG:Enabled]\r\nok\r\n");
+    EXPECT_EQ(run("G5 X1 I4190 J0 P4189 Q0 F600"), "ok\r\n");
+    EXPECT_EQ(run("G5 X1 I4200 J0 P4199 Q0 F600"), "error:33\r\n");
+    EXPECT_EQ(run("G5 X1 I0 J4190 P0 Q4189 F600"), "ok\r\n");
+    EXPECT_EQ(run("G5 X1 I0 J4195 P0 Q4195 F600"), "error:33\r\n");
+}
+
 // G5 (Marlin's cubic Bezier): I J the first control point from the start, P Q the second from
 // the end; a G5 without I J continues the previous one smoothly (its first arm mirrors the last
 // one's), with no stop at the joint.

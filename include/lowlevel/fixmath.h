@@ -50,6 +50,11 @@ __attribute__((noinline)) inline uint32_t abs32(int32_t v) {
     return v < 0 ? static_cast<uint32_t>(-(v + 1)) + 1u : static_cast<uint32_t>(v);
 }
 
+/// min(a, b), unsigned (one shared copy: the planner's limits, the curves' radii).
+__attribute__((noinline)) inline uint32_t min32(uint32_t a, uint32_t b) {
+    return a < b ? a : b;
+}
+
 /// Angles in radians x 2^29 (pi = 1686629713): the parameter of arcs and ellipses.
 constexpr int32_t kPiQ29 = 1686629713;
 
